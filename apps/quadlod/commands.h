@@ -1,0 +1,42 @@
+// The CLI's subcommands. Each add_*() registers one subcommand on the app and returns the
+// function that runs it after parsing; main() only dispatches. Commands do argument handling
+// and printing; all work happens in the library.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace quadlod::cli {
+
+/// Exit codes, documented in README.md ("CLI reference").
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitUsage = 1,     ///< bad command line
+  kExitBadInput = 2,  ///< unreadable/invalid input, or an output that cannot be written
+  kExitInternal = 3,  ///< a bug: an exception escaped
+};
+
+struct GlobalOptions {
+  bool quiet = false;  ///< no progress on stderr
+};
+
+/// A registered subcommand and the function that runs it once its options are parsed.
+struct Command {
+  CLI::App* sub = nullptr;
+  std::function<int()> run;
+};
+
+Command add_info(CLI::App& app, const GlobalOptions& global);
+Command add_eval(CLI::App& app, const GlobalOptions& global);
+Command add_generate(CLI::App& app, const GlobalOptions& global);
+
+/// Prints "quadlod: message" on stderr and returns kExitBadInput.
+int fail(const std::string& message);
+
+/// True when a and b name the same file (existing or not); used to refuse overwriting an input.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+
+}  // namespace quadlod::cli

@@ -1,0 +1,34 @@
+// quadlod — procedural meshes with known topology, for tests, benchmarks and the demo.
+//
+// Every generator returns counter-clockwise (outward-facing) polygons with per-corner UVs.
+// The known answers tests rely on are stated with each generator.
+#pragma once
+
+#include "quadlod/mesh.h"
+
+namespace quadlod {
+
+/// Planar n×m quad grid in the XY plane covering [0,width]×[0,height].
+/// (n+1)(m+1) vertices, n·m quads, 2(n+m) boundary edges, n+m open poly-chords.
+PolyMesh make_grid(Index n, Index m, double width = 1.0, double height = 1.0);
+
+/// Closed torus of n (around the main ring) × m (around the tube) quads. n,m >= 3.
+/// n·m vertices and quads, no boundary, n+m closed poly-chords.
+PolyMesh make_torus(Index n, Index m, double major_radius = 1.0, double minor_radius = 0.35);
+
+/// Open cylinder (no caps) of n quads around × m quads along its axis (Z), n >= 3.
+/// n(m+1) vertices, 2 boundary loops, n open chords along the axis and m closed rings.
+PolyMesh make_cylinder(Index n, Index m, double radius = 0.5, double height = 1.0);
+
+/// Axis-aligned cube [-s/2,s/2]^3 whose every side is k×k quads (k >= 1), vertices shared.
+/// 6k² quads; 3k closed poly-chords (3 when k = 1).
+PolyMesh make_cube(Index k = 1, double size = 1.0);
+
+/// The project's own demo asset: a closed, quad-dominant "vase" — a surface of revolution with
+/// a wavy, bulging profile (so curvature varies along the loops), closed at the bottom by a
+/// triangle fan around a pole vertex and at the top by one `segments`-gon lid, so triangles,
+/// quads and an n-gon all occur. `segments` (>= 3) quads around × `rings` (>= 1) along:
+/// segments·rings quads, `segments` triangles, one n-gon; closed, one component.
+PolyMesh make_demo_vase(Index segments = 48, Index rings = 40);
+
+}  // namespace quadlod

@@ -1,0 +1,43 @@
+// Disjoint-set forest with path halving and union by size. Used for face components, vertex
+// fans, and the cluster collapse of §3.3.2 (vertices joined by collapsed edges).
+#pragma once
+
+#include "quadlod/mesh.h"
+
+#include <numeric>
+#include <utility>
+#include <vector>
+
+namespace quadlod {
+
+class UnionFind {
+ public:
+  explicit UnionFind(Index n) : parent_(n), size_(n, 1) {
+    std::iota(parent_.begin(), parent_.end(), Index{0});
+  }
+  Index find(Index x) {
+    while (parent_[x] != x) {
+      parent_[x] = parent_[parent_[x]];
+      x = parent_[x];
+    }
+    return x;
+  }
+  /// Joins the sets of a and b; returns the new root, or kInvalidIndex if already joined.
+  Index unite(Index a, Index b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return kInvalidIndex;
+    if (size_[a] < size_[b]) std::swap(a, b);
+    parent_[b] = a;
+    size_[a] += size_[b];
+    return a;
+  }
+  Index set_size(Index x) { return size_[find(x)]; }
+  Index size() const { return static_cast<Index>(parent_.size()); }
+
+ private:
+  std::vector<Index> parent_;
+  std::vector<Index> size_;
+};
+
+}  // namespace quadlod

@@ -1,0 +1,153 @@
+// End-to-end tests of the quadlod executable: exit codes, one-line errors, no stray outputs.
+#include "cli_runner.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+
+using namespace quadlod::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+int count_lines(const std::string& s) {
+  return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
+
+// Every bad input must give exit code 2 and exactly one line on stderr that names the file.
+void expect_one_line_error(const CliRun& run, const std::string& must_contain) {
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_EQ(count_lines(run.err), 1) << run.err;
+  EXPECT_NE(run.err.find(must_contain), std::string::npos) << run.err;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  fs::path dir;
+};
+
+}  // namespace
+
+TEST_F(CliTest, UsageErrorsExitWithOne) {
+  EXPECT_EQ(run_cli("", dir).exit_code, 1);
+  EXPECT_EQ(run_cli("frobnicate", dir).exit_code, 1);
+  EXPECT_EQ(run_cli("info", dir).exit_code, 1);
+  EXPECT_EQ(run_cli("--help", dir).exit_code, 0);
+}
+
+TEST_F(CliTest, InfoJsonHasTheDocumentedKeys) {
+  const fs::path mesh = dir / "vase.obj";
+  ASSERT_EQ(run_cli("generate vase --n 10 --m 4 -o " + mesh.string(), dir).exit_code, 0);
+  const CliRun run = run_cli("info --json " + mesh.string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  for (const char* key : {"vertices", "faces", "triangles", "quads", "ngons", "tri_equivalent",
+                          "boundary_edges", "nonmanifold_edges", "degenerate_faces", "components",
+                          "has_uvs", "bbox", "edges", "boundary_loops", "nonmanifold_vertices",
+                          "duplicate_faces", "faces_by_degree"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["faces"], 51);
+  EXPECT_EQ(j["quads"], 40);
+  EXPECT_EQ(j["triangles"], 10);
+  EXPECT_EQ(j["ngons"], 1);
+  EXPECT_EQ(j["tri_equivalent"], 98);
+  EXPECT_EQ(j["boundary_edges"], 0);
+  EXPECT_EQ(j["components"], 1);
+  EXPECT_EQ(j["has_uvs"], true);
+  EXPECT_EQ(j["faces_by_degree"]["10"], 1);
+}
+
+TEST_F(CliTest, InfoCountsRepeatedIndexFacesInsteadOfRefusing) {
+  const fs::path mesh = dir / "rep.obj";
+  write_text(mesh, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 2 3\n");
+  const CliRun run = run_cli("info --json " + mesh.string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["repeated_index_faces"], 1);
+  EXPECT_EQ(j["degenerate_faces"], 1);
+}
+
+TEST_F(CliTest, BadInputTruncatedPly) {
+  const fs::path mesh = dir / "trunc.ply";
+  write_text(mesh, "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\n"
+                   "property float y\nproperty float z\nelement face 6\n"
+                   "property list uchar int vertex_indices\nend_header\n\x01\x02");
+  expect_one_line_error(run_cli("info " + mesh.string(), dir), "trunc.ply");
+}
+
+TEST_F(CliTest, BadInputTruncatedObj) {
+  const fs::path mesh = dir / "trunc.obj";
+  write_text(mesh, "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3 4");  // the face names vertex 4: cut short
+  expect_one_line_error(run_cli("info " + mesh.string(), dir), "trunc.obj");
+}
+
+TEST_F(CliTest, BadInputGarbageBytes) {
+  const fs::path mesh = dir / "garbage.obj";
+  std::string bytes;
+  for (int i = 0; i < 4096; ++i) bytes.push_back(static_cast<char>((i * 2654435761u) >> 13));
+  write_text(mesh, bytes);
+  expect_one_line_error(run_cli("info " + mesh.string(), dir), "garbage.obj");
+}
+
+TEST_F(CliTest, BadInputNonFiniteCoordinates) {
+  for (const char* value : {"nan", "inf", "-inf", "1e999"}) {
+    const fs::path mesh = dir / "nonfinite.obj";
+    write_text(mesh, std::string("v 0 0 0\nv 1 0 0\nv 0 ") + value + " 0\nf 1 2 3\n");
+    expect_one_line_error(run_cli("info " + mesh.string(), dir), "nonfinite.obj:3");
+  }
+}
+
+TEST_F(CliTest, BadInputIndexOutOfRange) {
+  const fs::path mesh = dir / "range.obj";
+  write_text(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 9\n");
+  expect_one_line_error(run_cli("info " + mesh.string(), dir), "range.obj:5");
+  const fs::path off = dir / "range.off";
+  write_text(off, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  expect_one_line_error(run_cli("info " + off.string(), dir), "range.off");
+}
+
+TEST_F(CliTest, BadInputEmptyMesh) {
+  const fs::path mesh = dir / "empty.obj";
+  write_text(mesh, "# nothing here\n");
+  expect_one_line_error(run_cli("info " + mesh.string(), dir), "empty.obj");
+  const fs::path zero = dir / "zero.obj";
+  write_text(zero, "");
+  expect_one_line_error(run_cli("info " + zero.string(), dir), "zero.obj");
+}
+
+TEST_F(CliTest, BadInputFaceUsesVertexTwice) {
+  const fs::path mesh = dir / "twice.obj";
+  write_text(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n");
+  const fs::path out = dir / "out.obj";
+  expect_one_line_error(run_cli("eval " + mesh.string() + " " + mesh.string(), dir), "twice.obj:4");
+}
+
+TEST_F(CliTest, BadInputMissingFile) {
+  expect_one_line_error(run_cli("info " + (dir / "nope.obj").string(), dir), "nope.obj");
+}
+
+TEST_F(CliTest, OutputInMissingDirectoryLeavesNothing) {
+  const fs::path target = dir / "no" / "such" / "dir" / "vase.obj";
+  expect_one_line_error(run_cli("generate vase -o " + target.string(), dir), "vase.obj");
+  EXPECT_FALSE(fs::exists(dir / "no"));
+  // Nothing else appeared in the scratch directory either.
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST_F(CliTest, GenerateWritesEveryFormat) {
+  for (const char* ext : {"obj", "ply", "off"}) {
+    const fs::path mesh = dir / (std::string("cube.") + ext);
+    ASSERT_EQ(run_cli("generate cube --n 2 -o " + mesh.string(), dir).exit_code, 0);
+    const CliRun run = run_cli("info --json " + mesh.string(), dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    EXPECT_EQ(j["quads"], 24);
+    EXPECT_EQ(j["vertices"], 26);
+    EXPECT_EQ(j["boundary_edges"], 0);
+  }
+}
