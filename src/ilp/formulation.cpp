@@ -1,0 +1,776 @@
+// Global edge selection, paper §3.2 (Eqs. 1–9). See formulation.h for the two formulations and
+// docs/formulation.md for the derivations and the choices where the paper is ambiguous.
+//
+// Face count (Eq. 1). A face f of k corners whose kept edges number S_f becomes a face of S_f
+// corners when S_f ≥ 3 and vanishes otherwise (Eq. 3 makes x_f = [S_f ≥ 3]), so its
+// triangle-equivalent count is
+//     t_f = x_f · (S_f − 2) = max(0, S_f − 2)                    (quad: 4 → 2, 3 → 1, ≤ 2 → 0)
+// which the paper's |F_tri| + 2|F_quad| is for triangles and quads.
+//
+// Fast face terms. With edges grouped (all opposing edges of a segment share one variable y_g),
+// most quads have both opposite pairs in single groups a and b:
+//
+//        b ────────── b          S_f = 2y_a + 2y_b,   t_f = 2·y_a·y_b
+//        │            │
+//        a    quad    a          More generally, if one group a covers m_a ≥ 2 of the k ≥ 4
+//        │            │          edges and the rest R (≤ 2 edges) is linear, then
+//        b ────────── b          t_f = y_a · (m_a − 2 + R)          (y_a = 0 ⇒ S_f = R ≤ 2 ⇒ 0)
+//
+// so all faces "owned" by group a contribute y_a · S_a with S_a = Σ (m_a − 2 + R) ≤ U_a = Σ (k−2),
+// one product per group linearised by three rows (McCormick, exact for binary y_a):
+//     w_a ≤ U_a y_a,   w_a ≤ S_a,   w_a ≥ S_a − U_a (1 − y_a).
+// That replaces three rows per quad by three rows per group. Faces of one group are linear,
+// triangles of several groups get an AND variable, and the rest (quads cut by breakpoints on both
+// pairs, n-gons) get the paper's per-face rows.
+#include "ilp/formulation.h"
+
+#include "geometry/quadric.h"
+#include "mesh/union_find.h"
+#include "util/progress.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <optional>
+#include <queue>
+
+namespace quadlod {
+
+using ilp::Col;
+using ilp::Term;
+
+std::vector<double> edge_importance(const PolyMesh& mesh, const Connectivity& conn, double cap) {
+  // Vertex quadrics: area-weighted planes of the incident faces (Garland & Heckbert 1997).
+  std::vector<Quadric> vq(mesh.num_vertices());
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Vec3 area = face_area_vector(mesh, f);
+    const double a = area.norm();
+    if (!(a > 0.0)) continue;
+    const Quadric q = a * Quadric::plane(face_centroid(mesh, f), area / a);
+    for (Index v : mesh.face_vertices(f)) vq[v] += q;
+  }
+  std::vector<double> q(conn.num_edges, 0.0);
+  double sum = 0.0;
+  Index positive = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const auto [a, b] = conn.edge_vertices[e];
+    q[e] = (vq[a] + vq[b]).minimize_on_segment(mesh.positions[a], mesh.positions[b]).error;
+    if (q[e] > 0.0) {
+      sum += q[e];
+      ++positive;
+    }
+  }
+  if (positive == 0) return q;
+  const double mean = sum / positive;
+  for (double& v : q) v = std::min(v / mean, cap);
+  return q;
+}
+
+std::uint64_t predicted_tri_equivalent(const PolyMesh& mesh, const Connectivity& conn,
+                                       const std::vector<std::uint8_t>& edge_kept) {
+  std::uint64_t n = 0;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    Index kept = 0;
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) kept += edge_kept[conn.corner_edge[c]];
+    n += kept > 2 ? kept - 2 : 0;
+  }
+  return n;
+}
+
+namespace {
+
+// ------------------------------------------------------------------------------------------
+// Decision groups: the units the greedy and the fast model decide on. With consistency (Eq. 4)
+// a group is the union of the opposing edges of segments that share an edge (only non-manifold
+// edges are shared); without it, and for edges of no quad, every edge is its own group.
+struct Groups {
+  Index count = 0;
+  std::vector<Index> edge_group;
+  std::vector<Index> offsets, edges;   // CSR group → edges
+  std::vector<std::uint8_t> fixed;     // 1: must be kept
+  std::vector<double> importance;      // Σ Q̂(e) over the group's edges
+};
+
+Groups make_groups(const Connectivity& conn, const AnalysisResult& analysis,
+                   const std::vector<double>& importance, const SelectionParams& params) {
+  UnionFind uf(conn.num_edges);
+  if (params.consistency)
+    for (const Segment& s : analysis.segmentation.segments)
+      for (std::size_t i = 1; i < s.opposing_edges.size(); ++i)
+        uf.unite(s.opposing_edges[0], s.opposing_edges[i]);
+  Groups g;
+  g.edge_group.assign(conn.num_edges, kInvalidIndex);
+  std::vector<Index> root_group(conn.num_edges, kInvalidIndex);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const Index r = uf.find(e);
+    if (root_group[r] == kInvalidIndex) root_group[r] = g.count++;
+    g.edge_group[e] = root_group[r];
+  }
+  g.offsets.assign(std::size_t{g.count} + 1, 0);
+  for (Index e = 0; e < conn.num_edges; ++e) ++g.offsets[g.edge_group[e] + 1];
+  std::partial_sum(g.offsets.begin(), g.offsets.end(), g.offsets.begin());
+  g.edges.resize(conn.num_edges);
+  std::vector<Index> fill(g.offsets.begin(), g.offsets.end() - 1);
+  for (Index e = 0; e < conn.num_edges; ++e) g.edges[fill[g.edge_group[e]]++] = e;
+  g.fixed.assign(g.count, 0);
+  g.importance.assign(g.count, 0.0);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    g.importance[g.edge_group[e]] += importance[e];
+    if (params.keep_nonmanifold_edges && conn.is_nonmanifold_edge(e)) g.fixed[g.edge_group[e]] = 1;
+  }
+  return g;
+}
+
+// Distinct groups of a list of edges, sorted.
+std::vector<Index> distinct_groups(const Groups& g, const std::vector<Index>& edges) {
+  std::vector<Index> out;
+  out.reserve(edges.size());
+  for (Index e : edges) out.push_back(g.edge_group[e]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// Geometric constraints (Eqs. 6–8) in terms of groups, shared by the greedy and the fast model.
+struct GroupConstraints {
+  std::vector<std::vector<Index>> geo;  // per Eq. 6 cluster: its groups (clusters with a fixed group dropped)
+  std::vector<std::vector<Index>> tri;  // per Eq. 7 cluster: its groups
+  std::vector<std::pair<Index, Index>> tri_neighbours;
+  std::vector<std::vector<Index>> group_geo, group_tri;  // inverse lists
+};
+
+GroupConstraints make_group_constraints(const Groups& g, const AnalysisResult& analysis,
+                                        const SelectionParams& params) {
+  GroupConstraints c;
+  c.group_geo.resize(g.count);
+  c.group_tri.resize(g.count);
+  if (!params.geometry) return c;
+  for (const EdgeCluster& cluster : analysis.medial.clusters) {
+    auto groups = distinct_groups(g, cluster.edges);
+    if (groups.empty() || std::any_of(groups.begin(), groups.end(), [&](Index x) { return g.fixed[x]; }))
+      continue;
+    for (Index x : groups) c.group_geo[x].push_back(static_cast<Index>(c.geo.size()));
+    c.geo.push_back(std::move(groups));
+  }
+  for (const TriangleCluster& cluster : analysis.triangles.clusters) {
+    auto groups = distinct_groups(g, cluster.edges);
+    for (Index x : groups) c.group_tri[x].push_back(static_cast<Index>(c.tri.size()));
+    c.tri.push_back(std::move(groups));
+  }
+  c.tri_neighbours = analysis.triangles.neighbours;
+  return c;
+}
+
+// ------------------------------------------------------------------------------------------
+// Face terms in group space.
+struct FaceGroups {
+  std::vector<Index> offsets, group, mult;  // CSR face → (group, multiplicity)
+  std::vector<Index> degree;
+};
+
+FaceGroups make_face_groups(const PolyMesh& mesh, const Connectivity& conn, const Groups& g) {
+  FaceGroups fg;
+  fg.offsets.push_back(0);
+  std::vector<Index> scratch;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    scratch.clear();
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c)
+      scratch.push_back(g.edge_group[conn.corner_edge[c]]);
+    std::sort(scratch.begin(), scratch.end());
+    for (std::size_t i = 0; i < scratch.size();) {
+      std::size_t j = i;
+      while (j < scratch.size() && scratch[j] == scratch[i]) ++j;
+      fg.group.push_back(scratch[i]);
+      fg.mult.push_back(static_cast<Index>(j - i));
+      i = j;
+    }
+    fg.offsets.push_back(static_cast<Index>(fg.group.size()));
+    fg.degree.push_back(mesh.face_size(f));
+  }
+  return fg;
+}
+
+// t_f = max(0, S_f − 2) for the current group values.
+inline Index face_count(const FaceGroups& fg, Index f, const std::vector<std::uint8_t>& y) {
+  Index kept = 0;
+  for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) kept += y[fg.group[i]] * fg.mult[i];
+  return kept > 2 ? kept - 2 : 0;
+}
+
+// ------------------------------------------------------------------------------------------
+// Greedy selection: collapse groups in order of cost per removed triangle-equivalent until the
+// count reaches the target, never leaving the Eq. 2 band below and never breaking Eq. 8.
+struct GreedyResult {
+  std::vector<std::uint8_t> y;  // per group
+  std::uint64_t count = 0;
+};
+
+GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                           std::uint64_t input_count, std::uint64_t target,
+                           const SelectionParams& params) {
+  GreedyResult r;
+  r.y.assign(g.count, 1);
+  r.count = input_count;
+  // group → faces touching it
+  std::vector<Index> gf_offsets(std::size_t{g.count} + 1, 0), gf;
+  const Index nf = static_cast<Index>(fg.degree.size());
+  for (Index f = 0; f < nf; ++f)
+    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) ++gf_offsets[fg.group[i] + 1];
+  std::partial_sum(gf_offsets.begin(), gf_offsets.end(), gf_offsets.begin());
+  gf.resize(gf_offsets.back());
+  {
+    std::vector<Index> fill(gf_offsets.begin(), gf_offsets.end() - 1);
+    for (Index f = 0; f < nf; ++f)
+      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) gf[fill[fg.group[i]]++] = f;
+  }
+  std::vector<Index> geo_kept(gc.geo.size());
+  for (std::size_t c = 0; c < gc.geo.size(); ++c) geo_kept[c] = static_cast<Index>(gc.geo[c].size());
+  std::vector<Index> tri_collapsed(gc.tri.size(), 0);
+  std::vector<std::vector<Index>> tri_nbrs(gc.tri.size());
+  for (const auto& [i, j] : gc.tri_neighbours) tri_nbrs[i].push_back(j);
+
+  auto removed = [&](Index grp) -> std::int64_t {
+    std::int64_t delta = 0;
+    r.y[grp] = 0;
+    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) delta -= face_count(fg, gf[k], r.y);
+    r.y[grp] = 1;
+    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) delta += face_count(fg, gf[k], r.y);
+    return delta;
+  };
+  auto cost = [&](Index grp) {
+    double c = params.lambda_edge * g.importance[grp];
+    for (Index cl : gc.group_geo[grp])
+      if (geo_kept[cl] == 1) c += params.lambda_geo;
+    return c;
+  };
+  auto allowed = [&](Index grp) {
+    // Eq. 8: a cluster that loses an edge needs every neighbour untouched, and grp must not
+    // belong to such a neighbour.
+    for (Index i : gc.group_tri[grp])
+      for (Index j : tri_nbrs[i]) {
+        if (tri_collapsed[j] > 0) return false;
+        if (std::binary_search(gc.tri[j].begin(), gc.tri[j].end(), grp)) return false;
+      }
+    return true;
+  };
+
+  struct Entry {
+    double key;
+    Index group;
+    std::int64_t delta;
+    bool operator<(const Entry& o) const { return key > o.key || (key == o.key && group > o.group); }
+  };
+  std::priority_queue<Entry> heap;
+  auto push = [&](Index grp) {
+    const std::int64_t d = removed(grp);
+    if (d > 0) heap.push({cost(grp) / double(d), grp, d});
+  };
+  for (Index grp = 0; grp < g.count; ++grp)
+    if (!g.fixed[grp]) push(grp);
+
+  const double lowest = (1.0 - params.epsilon_n) * double(target);
+  // The candidate that would have jumped below the band but lands closest to the target: taken at
+  // the end if the band was never reached and it gets closer than where the greedy stopped.
+  Index closest_skipped = kInvalidIndex;
+  double closest_distance = INFINITY;
+  while (r.count > target && !heap.empty()) {
+    const Entry top = heap.top();
+    heap.pop();
+    if (!r.y[top.group]) continue;
+    const std::int64_t d = removed(top.group);
+    if (d <= 0) continue;
+    const double key = cost(top.group) / double(d);
+    if (d != top.delta || key != top.key) {
+      heap.push({key, top.group, d});
+      continue;
+    }
+    if (!allowed(top.group)) continue;
+    // A group that would jump below the band is skipped: smaller ones may still fit.
+    if (double(r.count) - double(d) < lowest) {
+      const double distance = std::abs(double(r.count) - double(d) - double(target));
+      if (distance < closest_distance) {
+        closest_distance = distance;
+        closest_skipped = top.group;
+      }
+      continue;
+    }
+    r.y[top.group] = 0;
+    r.count -= static_cast<std::uint64_t>(d);
+    for (Index cl : gc.group_geo[top.group]) --geo_kept[cl];
+    for (Index cl : gc.group_tri[top.group]) ++tri_collapsed[cl];
+  }
+  if (double(r.count) > (1.0 + params.epsilon_n) * double(target) && closest_skipped != kInvalidIndex &&
+      r.y[closest_skipped] && allowed(closest_skipped)) {
+    const std::int64_t d = removed(closest_skipped);
+    if (d > 0 && std::abs(double(r.count) - double(d) - double(target)) <
+                     std::abs(double(r.count) - double(target))) {
+      r.y[closest_skipped] = 0;
+      r.count -= static_cast<std::uint64_t>(d);
+    }
+  }
+  return r;
+}
+
+// ------------------------------------------------------------------------------------------
+// The model. Columns are created in a fixed order so that the greedy start can be completed
+// into a full solution vector by evaluating the same definitions.
+class ModelBuilder {
+ public:
+  ModelBuilder(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+               const Groups& groups, const GroupConstraints& gc, const FaceGroups& fg,
+               const std::vector<double>& importance, const SelectionParams& params)
+      : mesh_(mesh), conn_(conn), analysis_(analysis), g_(groups), gc_(gc), fg_(fg),
+        importance_(importance), params_(params) {}
+
+  void build(std::uint64_t target, bool band) {
+    exact_ = params_.formulation == Formulation::Exact;
+    if (exact_) build_exact_vars();
+    else build_fast_vars();
+    build_faces();
+    build_count(target, band);
+    if (params_.geometry) {
+      build_geo_clusters();
+      build_tri_clusters();
+    }
+  }
+
+  /// The full column vector for a group assignment.
+  std::vector<double> complete(const std::vector<std::uint8_t>& y, std::uint64_t target) const {
+    std::vector<double> x(model.num_cols(), 0.0);
+    auto value_of_col = [&](Col c) { return x[c]; };
+    if (exact_) {
+      for (Index e = 0; e < conn_.num_edges; ++e) x[edge_col_[e]] = y[g_.edge_group[e]];
+    } else {
+      for (Index grp = 0; grp < g_.count; ++grp) x[group_col_[grp]] = y[grp];
+    }
+    (void)value_of_col;
+    for (const Aggregate& a : aggregates_) {
+      double s = a.constant;
+      for (const Term& t : a.rest) s += t.coef * x[t.col];
+      x[a.w] = x[a.owner] * s;
+    }
+    for (const GeneralFace& gf : general_) {
+      double s = 0;
+      for (const Term& t : gf.terms) s += t.coef * x[t.col];
+      if (gf.xf != kNone) x[gf.xf] = s >= 3.0 - 1e-9 ? 1.0 : 0.0;
+      x[gf.t] = std::max(0.0, s - 2.0);
+    }
+    double count = 0;
+    for (const Term& t : count_terms_) count += t.coef * x[t.col];
+    count += count_constant_;
+    const double diff = count - double(target);
+    x[p_] = std::max(0.0, diff);
+    x[q_] = std::max(0.0, -diff);
+    for (const GeoCluster& c : geo_) {
+      bool all_collapsed = true;
+      for (Col col : c.cols) all_collapsed &= x[col] < 0.5;
+      x[c.var] = all_collapsed ? 1.0 : 0.0;
+    }
+    for (const TriCluster& c : tri_) {
+      bool any_collapsed = false;
+      for (Col col : c.cols) any_collapsed |= x[col] < 0.5;
+      x[c.var] = any_collapsed ? 1.0 : 0.0;
+    }
+    return x;
+  }
+
+  /// Group values back from a solution (rounded).
+  std::vector<std::uint8_t> edge_bits(const std::vector<double>& x) const {
+    std::vector<std::uint8_t> kept(conn_.num_edges);
+    for (Index e = 0; e < conn_.num_edges; ++e)
+      kept[e] = x[exact_ ? edge_col_[e] : group_col_[g_.edge_group[e]]] > 0.5;
+    return kept;
+  }
+
+  ilp::Model model;
+  SelectionModelStats stats;
+
+ private:
+  static constexpr Col kNone = ~Col{0};
+  struct Aggregate {
+    Col owner, w;
+    double constant = 0, upper = 0;
+    std::vector<Term> rest;
+  };
+  struct GeneralFace {
+    Col xf = kNone, t = kNone;
+    std::vector<Term> terms;
+  };
+  struct GeoCluster {
+    Col var;
+    std::vector<Col> cols;
+  };
+  struct TriCluster {
+    Col var;
+    std::vector<Col> cols;
+  };
+
+  Col edge_col(Index e) const { return exact_ ? edge_col_[e] : group_col_[g_.edge_group[e]]; }
+
+  void build_fast_vars() {
+    group_col_.resize(g_.count);
+    for (Index grp = 0; grp < g_.count; ++grp) {
+      const double lo = g_.fixed[grp] ? 1.0 : 0.0;
+      group_col_[grp] = model.add_var(ilp::VarType::Binary, lo, 1.0,
+                                      -params_.lambda_edge * g_.importance[grp]);
+    }
+    stats.edge_groups = g_.count;
+    stats.fixed_kept_groups = static_cast<Index>(std::count(g_.fixed.begin(), g_.fixed.end(), 1));
+  }
+
+  void build_exact_vars() {
+    edge_col_.resize(conn_.num_edges);
+    for (Index e = 0; e < conn_.num_edges; ++e) {
+      const double lo = g_.fixed[g_.edge_group[e]] ? 1.0 : 0.0;
+      edge_col_[e] = model.add_var(ilp::VarType::Binary, lo, 1.0, -params_.lambda_edge * importance_[e]);
+    }
+    stats.edge_groups = conn_.num_edges;
+    // Eq. 4: x_e = x_e' within every segment.
+    if (params_.consistency)
+      for (const Segment& s : analysis_.segmentation.segments)
+        for (std::size_t i = 1; i < s.opposing_edges.size(); ++i)
+          model.add_eq({{edge_col_[s.opposing_edges[i]], 1.0}, {edge_col_[s.opposing_edges[0]], -1.0}}, 0.0);
+  }
+
+  // Terms Σ m x over the face's columns (merged per column).
+  std::vector<Term> face_terms(Index f) const {
+    std::vector<Term> terms;
+    for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
+      const Col col = edge_col(conn_.corner_edge[c]);
+      auto it = std::find_if(terms.begin(), terms.end(), [&](const Term& t) { return t.col == col; });
+      if (it == terms.end()) terms.push_back({col, 1.0});
+      else it->coef += 1.0;
+    }
+    return terms;
+  }
+
+  void build_faces() {
+    std::vector<std::vector<Term>> owner_rest(model.num_cols());
+    std::vector<double> owner_constant(model.num_cols(), 0.0), owner_upper(model.num_cols(), 0.0);
+    std::vector<Index> owned(model.num_cols(), 0);
+    for (Index f = 0; f < mesh_.num_faces(); ++f) {
+      const double k = mesh_.face_size(f);
+      std::vector<Term> terms = face_terms(f);
+      if (!exact_) {
+        if (terms.size() == 1) {  // one group: t_f = (k − 2) y
+          count_terms_.push_back({terms[0].col, k - 2.0});
+          ++stats.linear_faces;
+          continue;
+        }
+        // Owner: a group with m ≥ 2 and at most two other edges; prefer the larger group.
+        Col owner = kNone;
+        double owner_mult = 0;
+        for (const Term& t : terms)
+          if (t.coef >= 2.0 && k - t.coef <= 2.0 && k >= 4 &&
+              (owner == kNone || group_size(t.col) > group_size(owner))) {
+            owner = t.col;
+            owner_mult = t.coef;
+          }
+        if (owner != kNone) {
+          for (const Term& t : terms)
+            if (t.col != owner) owner_rest[owner].push_back(t);
+          owner_constant[owner] += owner_mult - 2.0;
+          owner_upper[owner] += k - 2.0;
+          ++owned[owner];
+          continue;
+        }
+        if (k == 3) {  // triangle over several groups: z = AND (continuous, exact for binary y)
+          const Col z = model.add_continuous(0.0, 1.0);
+          double s = 0;
+          for (const Term& t : terms) {
+            model.add_le({{z, t.coef}, {t.col, -t.coef}}, 0.0);  // m z ≤ m y
+            s += t.coef;
+          }
+          std::vector<Term> row = terms;
+          row.push_back({z, -1.0});
+          model.add_le(row, 2.0);  // z ≥ S − 2
+          general_.push_back({kNone, z, terms});
+          count_terms_.push_back({z, 1.0});
+          ++stats.triangle_faces;
+          continue;
+        }
+      }
+      add_general_face(terms, k);
+    }
+    for (Col owner = 0; owner < owned.size(); ++owner) {
+      if (!owned[owner]) continue;
+      Aggregate a;
+      a.owner = owner;
+      a.constant = owner_constant[owner];
+      a.upper = owner_upper[owner];
+      a.rest = std::move(owner_rest[owner]);
+      // Merge rest terms per column.
+      std::sort(a.rest.begin(), a.rest.end(), [](const Term& l, const Term& r) { return l.col < r.col; });
+      std::vector<Term> merged;
+      for (const Term& t : a.rest) {
+        if (!merged.empty() && merged.back().col == t.col) merged.back().coef += t.coef;
+        else merged.push_back(t);
+      }
+      a.rest = std::move(merged);
+      a.w = model.add_continuous(0.0, a.upper);
+      // w ≤ U y
+      model.add_le({{a.w, 1.0}, {owner, -a.upper}}, 0.0);
+      // w ≤ S = constant + rest
+      std::vector<Term> row = a.rest;
+      for (Term& t : row) t.coef = -t.coef;
+      row.push_back({a.w, 1.0});
+      model.add_le(row, a.constant);
+      // w ≥ S − U(1 − y)  ⇔  w − rest − U y ≥ constant − U
+      row.push_back({owner, -a.upper});
+      model.add_ge(row, a.constant - a.upper);
+      count_terms_.push_back({a.w, 1.0});
+      aggregates_.push_back(std::move(a));
+      ++stats.owner_aggregates;
+    }
+  }
+
+  double group_size(Col col) const {
+    // Only called in fast mode, where columns of groups are the first g_.count columns.
+    const Index grp = static_cast<Index>(col);
+    return grp < g_.count ? double(g_.offsets[grp + 1] - g_.offsets[grp]) : 0.0;
+  }
+
+  // The paper's per-face rows: Eq. 3 and t_f = x_f (S_f − 2) linearised.
+  void add_general_face(const std::vector<Term>& terms, double k) {
+    GeneralFace gf;
+    gf.terms = terms;
+    gf.xf = model.add_binary();
+    gf.t = model.add_continuous(0.0, k - 2.0);
+    std::vector<Term> row = terms;
+    row.push_back({gf.xf, -3.0});
+    model.add_ge(row, 0.0);  // Eq. 3: S ≥ 3 x_f
+    row.back().coef = -(k - 2.0);
+    model.add_le(row, 2.0);  // Eq. 3: S − 2 ≤ (k − 2) x_f   (the paper's 4 x_f for quads)
+    model.add_le({{gf.t, 1.0}, {gf.xf, -(k - 2.0)}}, 0.0);  // t ≤ (k − 2) x_f
+    row = terms;
+    for (Term& t : row) t.coef = -t.coef;
+    row.push_back({gf.t, 1.0});
+    model.add_ge(row, -2.0);  // t ≥ S − 2
+    row.push_back({gf.xf, 2.0});
+    model.add_le(row, 0.0);   // t ≤ S − 2 x_f
+    count_terms_.push_back({gf.t, 1.0});
+    general_.push_back(std::move(gf));
+    ++stats.general_faces;
+  }
+
+  // Eqs. 1–2 and the |N' − N| term of Eq. 9: N' − p + q = N with p, q ≥ 0 in the objective;
+  // the band of Eq. 2 is p, q ≤ ϵ_N N (bounds, no extra row).
+  void build_count(std::uint64_t target, bool band) {
+    const double n = double(target);
+    const double slack = band ? params_.epsilon_n * n : ilp::kInf;
+    p_ = model.add_continuous(0.0, slack, 1.0);
+    q_ = model.add_continuous(0.0, slack, 1.0);
+    std::vector<Term> row = count_terms_;
+    row.push_back({p_, -1.0});
+    row.push_back({q_, 1.0});
+    model.add_eq(row, n - count_constant_);
+  }
+
+  // Eq. 6: x_C = 1 iff every edge of cluster C is collapsed; λ_geo x_C in the objective.
+  void build_geo_clusters() {
+    if (exact_) {
+      for (const EdgeCluster& cluster : analysis_.medial.clusters) {
+        std::vector<Col> cols;
+        for (Index e : cluster.edges) cols.push_back(edge_col_[e]);
+        std::sort(cols.begin(), cols.end());
+        cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+        const Col xc = model.add_continuous(0.0, 1.0, params_.lambda_geo);
+        std::vector<Term> row{{xc, 1.0}};
+        for (Col c : cols) {
+          model.add_le({{xc, 1.0}, {c, 1.0}}, 1.0);  // x_C ≤ 1 − x_e
+          row.push_back({c, 1.0});
+        }
+        model.add_ge(row, 1.0);  // x_C ≥ 1 − Σ x_e
+        geo_.push_back({xc, std::move(cols)});
+      }
+    } else {
+      // Only the binding side: with λ_geo > 0 a minimiser never raises x_C above what
+      // x_C ≥ 1 − Σ y forces, so x_C ≤ 1 − y rows are redundant at every optimum.
+      for (const auto& groups : gc_.geo) {
+        const Col xc = model.add_continuous(0.0, 1.0, params_.lambda_geo);
+        std::vector<Term> row{{xc, 1.0}};
+        std::vector<Col> cols;
+        for (Index grp : groups) {
+          row.push_back({group_col_[grp], 1.0});
+          cols.push_back(group_col_[grp]);
+        }
+        model.add_ge(row, 1.0);
+        geo_.push_back({xc, std::move(cols)});
+      }
+    }
+    stats.geo_clusters = static_cast<Index>(geo_.size());
+  }
+
+  // Eqs. 7–8: x_Ct = 1 iff some edge of C_t is collapsed; then every neighbour keeps all edges.
+  void build_tri_clusters() {
+    std::vector<std::vector<Col>> cols_of(analysis_.triangles.clusters.size());
+    for (std::size_t i = 0; i < cols_of.size(); ++i) {
+      auto& cols = cols_of[i];
+      for (Index e : analysis_.triangles.clusters[i].edges) cols.push_back(edge_col(e));
+      std::sort(cols.begin(), cols.end());
+      if (!exact_) cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+      Col var;
+      const double size = double(cols.size());
+      if (exact_) {
+        // The paper's rows; x_Ct binary, because with a continuous x_Ct the first row only
+        // forces x_Ct ≥ 1/|C| when one edge is dropped (docs/formulation.md).
+        var = model.add_binary();
+        std::vector<Term> row{{var, size}};
+        for (Col c : cols) row.push_back({c, 1.0});
+        model.add_ge(row, size);        // Σ x_e + |C| x_Ct ≥ |C|
+        row[0].coef = 1.0;
+        model.add_le(row, size);        // x_Ct ≤ |C| − Σ x_e
+      } else {
+        var = model.add_continuous(0.0, 1.0);
+        for (Col c : cols) model.add_ge({{var, 1.0}, {c, 1.0}}, 1.0);  // x_Ct ≥ 1 − y_g
+      }
+      tri_.push_back({var, cols});
+    }
+    for (const auto& [i, j] : analysis_.triangles.neighbours) {
+      const auto& cj = cols_of[j];
+      std::vector<Term> row{{tri_[i].var, double(cj.size())}};
+      for (Col c : cj) row.push_back({c, -1.0});
+      model.add_le(row, 0.0);  // Eq. 8: |C_j| x_Ct(i) ≤ Σ_{e ∈ C_j} x_e
+      ++stats.tri_neighbour_rows;
+    }
+    stats.tri_clusters = static_cast<Index>(tri_.size());
+  }
+
+  const PolyMesh& mesh_;
+  const Connectivity& conn_;
+  const AnalysisResult& analysis_;
+  const Groups& g_;
+  const GroupConstraints& gc_;
+  const FaceGroups& fg_;
+  const std::vector<double>& importance_;
+  const SelectionParams& params_;
+  bool exact_ = false;
+  std::vector<Col> group_col_, edge_col_;
+  std::vector<Term> count_terms_;
+  double count_constant_ = 0.0;
+  std::vector<Aggregate> aggregates_;
+  std::vector<GeneralFace> general_;
+  std::vector<GeoCluster> geo_;
+  std::vector<TriCluster> tri_;
+  Col p_ = kNone, q_ = kNone;
+};
+
+Index count_collapsed_clusters(const GroupConstraints& gc, const std::vector<std::uint8_t>& y) {
+  Index n = 0;
+  for (const auto& groups : gc.geo)
+    n += std::all_of(groups.begin(), groups.end(), [&](Index grp) { return !y[grp]; });
+  return n;
+}
+
+}  // namespace
+
+SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
+                             const AnalysisResult& analysis, std::uint64_t target,
+                             const SelectionParams& params) {
+  SelectionResult result;
+  Stopwatch clock;
+  result.input_tri_equivalent = tri_equivalent_count(mesh);
+  result.target = target;
+  result.edge_kept.assign(conn.num_edges, 1);
+  result.predicted = result.greedy_predicted = result.input_tri_equivalent;
+  if (target >= result.input_tri_equivalent) {
+    result.note = "target " + std::to_string(target) + " is at or above the input size " +
+                  std::to_string(result.input_tri_equivalent) + ": nothing to do";
+    return result;
+  }
+
+  const std::vector<double> importance = edge_importance(mesh, conn, params.importance_cap);
+  const Groups groups = make_groups(conn, analysis, importance, params);
+  const GroupConstraints gc = make_group_constraints(groups, analysis, params);
+  const FaceGroups fg = make_face_groups(mesh, conn, groups);
+
+  Stopwatch greedy_clock;
+  const GreedyResult greedy = greedy_select(groups, gc, fg, result.input_tri_equivalent, target, params);
+  result.seconds_greedy = greedy_clock.seconds();
+  result.greedy_predicted = greedy.count;
+  const double lo = (1.0 - params.epsilon_n) * double(target);
+  const double hi = (1.0 + params.epsilon_n) * double(target);
+  const bool reachable = double(greedy.count) >= lo && double(greedy.count) <= hi;
+  result.seconds_build = 0.0;
+
+  // Phase 1: Eq. 2 as a hard band. The greedy selection is the start when it lies in the band;
+  // otherwise the solver has to find a feasible point itself, with half the time budget.
+  // Phase 2 (only if phase 1 ends without a solution): no band, the greedy selection as start,
+  // so the result is the closest count the hard constraints allow (reported in `note`).
+  const double time_limit = params.solve.time_limit_seconds;
+  auto run = [&](ModelBuilder& builder, double seconds) -> std::vector<double> {
+    std::string error;
+    auto solver = ilp::make_solver(params.solver, &error);
+    if (!solver) {
+      result.note = error;
+      return {};
+    }
+    Stopwatch solve_clock;
+    ilp::SolveParams sp = params.solve;
+    sp.time_limit_seconds = seconds;
+    if (!params.quiet && !sp.on_progress)
+      sp.on_progress = [](const ilp::Progress& p) {
+        std::fprintf(stderr, "\rselect      objective %.4f  bound %.4f  %6.1f s", p.objective,
+                     p.best_bound, p.seconds);
+        std::fflush(stderr);
+      };
+    result.solve = solver->solve(builder.model, sp);
+    if (!params.quiet) std::fprintf(stderr, "\n");
+    result.solver_ran = true;
+    result.seconds_solve += solve_clock.seconds();
+    std::vector<double> x = std::move(result.solve.solution);
+    result.solve.solution.clear();
+    return x;
+  };
+
+  Stopwatch build_clock;
+  ModelBuilder banded(mesh, conn, analysis, groups, gc, fg, importance, params);
+  banded.build(target, true);
+  const std::vector<double> banded_start = banded.complete(greedy.y, target);
+  if (reachable) banded.model.set_initial_solution(banded_start);
+  result.model = banded.stats;
+  result.model.size = banded.model.size();
+  result.seconds_build = build_clock.seconds();
+
+  std::vector<double> solution;
+  const ModelBuilder* used = &banded;
+  if (reachable) {
+    result.greedy_objective = banded.model.evaluate(banded_start);
+    solution = time_limit > 0.0 ? run(banded, time_limit) : banded_start;
+    if (solution.empty()) solution = banded_start;
+    result.band_enforced = true;
+  } else if (time_limit > 0.0) {
+    solution = run(banded, 0.5 * time_limit);
+    result.band_enforced = !solution.empty();
+  }
+  std::optional<ModelBuilder> open;
+  if (solution.empty()) {
+    Stopwatch rebuild_clock;
+    open.emplace(mesh, conn, analysis, groups, gc, fg, importance, params);
+    open->build(target, false);
+    const std::vector<double> start = open->complete(greedy.y, target);
+    open->model.set_initial_solution(start);
+    result.greedy_objective = open->model.evaluate(start);
+    result.seconds_build += rebuild_clock.seconds();
+    solution = time_limit > 0.0 ? run(*open, 0.5 * time_limit) : start;
+    if (solution.empty()) solution = start;
+    used = &*open;
+  }
+  result.objective = used->model.evaluate(solution);
+  result.edge_kept = used->edge_bits(solution);
+  result.predicted = predicted_tri_equivalent(mesh, conn, result.edge_kept);
+  std::vector<std::uint8_t> y(groups.count, 1);
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (!result.edge_kept[e]) y[groups.edge_group[e]] = 0;
+  result.collapsed_groups = static_cast<Index>(std::count(y.begin(), y.end(), 0));
+  result.collapsed_clusters = count_collapsed_clusters(gc, y);
+  if (!result.band_enforced && result.note.empty())
+    result.note = "target " + std::to_string(target) + " is out of reach of the hard constraints: " +
+                  "the closest selection found has " + std::to_string(result.predicted) +
+                  " triangle-equivalents";
+  (void)clock;
+  return result;
+}
+
+}  // namespace quadlod

@@ -1,0 +1,120 @@
+// Global edge selection (paper §3.2, Eqs. 1–9): which input edges to keep so that the reduced
+// mesh has about N triangle-equivalents, poly-chord segments are kept or collapsed as a whole,
+// geometric clusters keep at least one edge, and important edges survive.
+//
+// Two formulations of the same problem (docs/formulation.md has the derivations):
+//
+//   Exact  — the paper as written: one binary x_e per edge, one binary x_f per face with the
+//            edge–face consistency rows of Eq. 3, the face count N' of Eq. 1 linearised per face
+//            (t_f = x_f·(Σx_e − 2), three rows), x_e = x_e' rows for every segment (Eq. 4), both
+//            rows of Eq. 6 per cluster edge, Eqs. 7–8 per triangle cluster.
+//   Fast   — the same optimum with far fewer rows: one binary per *edge group* (the opposing edges
+//            of a segment, joined through shared non-manifold edges) instead of equality rows;
+//            faces whose count is a product "group × linear rest" aggregated per owning group
+//            (three rows per group instead of three per quad); only the binding side of Eq. 6;
+//            Eq. 7 as x_Ct ≥ 1 − y_g per group. A greedy selection is handed to the solver as
+//            its start, so a timed-out solve is never worse than greedy and never empty.
+//
+// Either way the result is one bit per input edge: kept (1) or collapsed (0).
+#pragma once
+
+#include "ilp/solver.h"
+#include "mesh/connectivity.h"
+#include "quadlod/mesh.h"
+#include "topology/analysis.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace quadlod {
+
+enum class Formulation { Fast, Exact };
+
+struct SelectionParams {
+  /// ϵ_N of Eq. 2: N' must lie within (1 ± epsilon_n)·N. The paper's value.
+  double epsilon_n = 0.03;
+  /// λ_geo of Eq. 9: cost of collapsing every edge of one geometric cluster (Eq. 6), in
+  /// triangle-equivalents. Default chosen by measurement (docs/parameters.md).
+  double lambda_geo = 4.0;
+  /// λ_edge of Eq. 9: weight of the edge-importance term Σ Q(e)·x_e, where Q(e) is the edge's
+  /// quadric collapse cost divided by the mean over all edges (so 1 = an average edge).
+  /// Default chosen by measurement (docs/parameters.md).
+  double lambda_edge = 0.05;
+  /// Importance values are capped at this multiple of the mean, so a few huge quadrics (long
+  /// edges at sharp corners) cannot dominate the count term.
+  double importance_cap = 20.0;
+
+  Formulation formulation = Formulation::Fast;
+  /// Eq. 4 on/off (the "w/o consistency" ablation: every edge decided on its own).
+  bool consistency = true;
+  /// Eqs. 6–8 on/off (the "w/o geometric constraints" ablation).
+  bool geometry = true;
+  /// Edges with more than two faces cannot be collapsed safely (the collapse would join
+  /// unrelated sheets), so their groups are fixed to "kept".
+  bool keep_nonmanifold_edges = true;
+
+  /// The MIP solve. time_limit_seconds <= 0 skips the solver and returns the greedy selection.
+  std::string solver = "cbc";
+  ilp::SolveParams solve;
+  bool quiet = true;  ///< progress lines on stderr when false
+};
+
+/// Sizes of the model as built, for reports.
+struct SelectionModelStats {
+  Index edge_groups = 0;         ///< decision units (fast) or edges (exact)
+  Index fixed_kept_groups = 0;   ///< groups fixed to 1 (non-manifold edges)
+  Index owner_aggregates = 0;    ///< fast: groups that carry aggregated face terms
+  Index general_faces = 0;       ///< faces needing their own x_f / t_f
+  Index triangle_faces = 0;      ///< triangles with their own AND variable
+  Index linear_faces = 0;        ///< faces whose count is linear in one group
+  Index geo_clusters = 0;        ///< Eq. 6 clusters in the model
+  Index tri_clusters = 0;        ///< Eq. 7 clusters
+  Index tri_neighbour_rows = 0;  ///< Eq. 8 rows
+  ilp::ModelSize size;
+};
+
+struct SelectionResult {
+  /// One entry per Connectivity edge: 1 kept, 0 collapsed. Always filled (all 1 when there is
+  /// nothing to do).
+  std::vector<std::uint8_t> edge_kept;
+
+  std::uint64_t input_tri_equivalent = 0;
+  std::uint64_t target = 0;             ///< N (tri-equivalents)
+  std::uint64_t predicted = 0;          ///< N' of the selection (Eq. 1, exact for the bits)
+  std::uint64_t greedy_predicted = 0;   ///< N' of the greedy start
+  double objective = 0.0;               ///< Eq. 9 value of the selection
+  double greedy_objective = 0.0;        ///< Eq. 9 value of the greedy start
+  Index collapsed_groups = 0;
+  Index collapsed_clusters = 0;         ///< Eq. 6 clusters with every edge collapsed
+  bool band_enforced = false;           ///< Eq. 2 was a hard constraint (else unreachable)
+  /// Empty, or why the selection is not what was asked for ("target at or above the input
+  /// size: nothing to do", "target below what the hard constraints allow: closest is ...").
+  std::string note;
+
+  bool solver_ran = false;
+  ilp::SolveResult solve;               ///< statistics (solution vector dropped)
+  SelectionModelStats model;
+  double seconds_build = 0.0;
+  double seconds_greedy = 0.0;
+  double seconds_solve = 0.0;
+};
+
+/// Selects the edges to keep for a reduction to `target` triangle-equivalents.
+/// `analysis` must come from analyze() on the same mesh and connectivity (its segmentation and
+/// clustering parameters decide the segments and clusters used here).
+SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
+                             const AnalysisResult& analysis, std::uint64_t target,
+                             const SelectionParams& params = {});
+
+/// Q(e) of Eq. 9 for every edge: the quadric error (Garland–Heckbert, area-weighted face planes
+/// summed at both endpoints) of collapsing the edge to the best point on it, divided by the
+/// mean over all edges with a positive error and capped at `cap`. All zero on a flat mesh.
+std::vector<double> edge_importance(const PolyMesh& mesh, const Connectivity& conn, double cap);
+
+/// N' of Eq. 1 for a given edge selection: Σ_f max(0, kept edges of f − 2). This is the count
+/// the ILP optimises; the mesh produced by the collapse may differ slightly (see §3.3).
+std::uint64_t predicted_tri_equivalent(const PolyMesh& mesh, const Connectivity& conn,
+                                       const std::vector<std::uint8_t>& edge_kept);
+
+}  // namespace quadlod
