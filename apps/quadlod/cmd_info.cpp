@@ -4,6 +4,7 @@
 #include "mesh/connectivity.h"
 #include "mesh/validation.h"
 #include "quadlod/io.h"
+#include "topology/analysis.h"
 #include "util/progress.h"
 
 #include <cstdio>
@@ -16,6 +17,7 @@ namespace {
 struct InfoOptions {
   std::string mesh;
   bool json = false;
+  bool topology = false;
 };
 
 void print_text(const std::string& path, const MeshStats& s, double read_seconds) {
@@ -49,6 +51,8 @@ Command add_info(CLI::App& app, const GlobalOptions& global) {
   CLI::App* sub = app.add_subcommand("info", "Counts, validity and topology of a mesh");
   sub->add_option("MESH", opt->mesh, "Input mesh (.obj, .ply, .off)")->required();
   sub->add_flag("--json", opt->json, "Print one JSON object instead of text");
+  sub->add_flag("--topology", opt->topology,
+                "Also poly-chords, segments and clusters (paper §3.1-§3.2.4)");
   return {sub, [opt, &global]() -> int {
             ReadOptions read_options;
             read_options.allow_repeated_vertex = true;  // info counts them instead of refusing
@@ -57,14 +61,41 @@ Command add_info(CLI::App& app, const GlobalOptions& global) {
             Stopwatch clock;
             const Connectivity conn = build_connectivity(read.mesh);
             const MeshStats stats = compute_stats(read.mesh, conn);
+            nlohmann::json topology;
+            if (opt->topology) {
+              if (stats.repeated_index_faces > 0)
+                return fail(opt->mesh + ": --topology needs faces without repeated vertices (" +
+                            std::to_string(stats.repeated_index_faces) + " found)");
+              const AnalysisResult a = analyze(read.mesh, conn);
+              topology = {
+                  {"polychords", a.polychords.chords.size()},
+                  {"polychords_closed", a.polychords.num_closed},
+                  {"polychords_self_crossing", a.polychords.num_self_crossing},
+                  {"segments", a.segmentation.segments.size()},
+                  {"breakpoints", a.segmentation.stats.num_breakpoints},
+                  {"quad_clusters", a.medial.clusters.size()},
+                  {"triangle_clusters", a.triangles.clusters.size()},
+                  {"topology_seconds", a.timings.total_ms / 1000.0},
+              };
+            }
             if (opt->json) {
               nlohmann::json j = to_json(stats);
+              if (opt->topology) j.update(topology);
               j["file"] = opt->mesh;
               j["read_seconds"] = read.seconds;
               j["analysis_seconds"] = clock.seconds();
               std::printf("%s\n", j.dump(2).c_str());
             } else {
               print_text(opt->mesh, stats, read.seconds);
+              if (opt->topology)
+                std::printf("  poly-chords         %s (%s closed, %s self-crossing)\n"
+                            "  segments            %s (%s breakpoints)\n"
+                            "  clusters            %s quad, %s triangle\n"
+                            "  topology time       %.3f s\n",
+                            topology["polychords"].dump().c_str(), topology["polychords_closed"].dump().c_str(),
+                            topology["polychords_self_crossing"].dump().c_str(), topology["segments"].dump().c_str(),
+                            topology["breakpoints"].dump().c_str(), topology["quad_clusters"].dump().c_str(),
+                            topology["triangle_clusters"].dump().c_str(), topology["topology_seconds"].get<double>());
             }
             (void)global;
             return kExitOk;

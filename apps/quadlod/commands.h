@@ -32,6 +32,8 @@ struct Command {
 Command add_info(CLI::App& app, const GlobalOptions& global);
 Command add_eval(CLI::App& app, const GlobalOptions& global);
 Command add_generate(CLI::App& app, const GlobalOptions& global);
+Command add_simplify(CLI::App& app, const GlobalOptions& global);
+Command add_analyze(CLI::App& app, const GlobalOptions& global);
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

@@ -24,12 +24,16 @@ int main(int argc, char** argv) {
   using namespace quadlod::cli;
   CLI::App app{"quadlod — quad-dominant mesh reduction that keeps edge loops"};
   app.require_subcommand(1);
+  app.fallthrough();  // global flags (-q) are accepted after the subcommand too
   app.set_version_flag("--version", "quadlod 0.1.0");
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress output on stderr");
 
   const std::vector<Command> commands = {
+      add_simplify(app, global),
       add_info(app, global),
+      add_eval(app, global),
+      add_analyze(app, global),
       add_generate(app, global),
   };
 

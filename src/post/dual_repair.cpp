@@ -19,14 +19,23 @@ struct Clusters {
   explicit Clusters(Index n) : uf(n), valence(n, 0) {}
 };
 
+// Valence of a merged vertex = number of distinct clusters its kept edges lead to: two kept
+// edges from one cluster to another merge into one output edge (e.g. where a collapsed row
+// crosses a collapsed column, the quad at the crossing becomes a valence-4 vertex, not 8).
 Clusters make_clusters(const Connectivity& conn, const std::vector<std::uint8_t>& kept) {
   Clusters c(conn.num_vertices);
   for (Index e = 0; e < conn.num_edges; ++e)
     if (!kept[e]) c.uf.unite(conn.edge_vertices[e][0], conn.edge_vertices[e][1]);
+  std::vector<std::pair<Index, Index>> links;
   for (Index e = 0; e < conn.num_edges; ++e) {
     if (!kept[e]) continue;
     const Index a = c.uf.find(conn.edge_vertices[e][0]), b = c.uf.find(conn.edge_vertices[e][1]);
     if (a == b) continue;  // a kept edge inside a cluster degenerates; it bounds nothing
+    links.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(links.begin(), links.end());
+  links.erase(std::unique(links.begin(), links.end()), links.end());
+  for (const auto& [a, b] : links) {
     ++c.valence[a];
     ++c.valence[b];
   }
@@ -279,18 +288,25 @@ class Repairer {
         const Index a = id(conn_.edge_vertices[e][0]), b = id(conn_.edge_vertices[e][1]);
         if (a != kInvalidIndex && b != kInvalidIndex) uf.unite(a, b);
       }
-    std::vector<Index> valence(sorted.size(), 0);
+    // Distinct (part, neighbour) links; neighbours outside the cluster are named by their
+    // cluster root, offset past the local part ids.
     Index parts = 0;
     for (Index i = 0; i < sorted.size(); ++i) parts += uf.find(i) == i;
+    const Index outside = static_cast<Index>(sorted.size());
+    std::vector<std::pair<Index, Index>> links;
     for (Index e : edges) {
       if (!kept_[e]) continue;
       const Index a = id(conn_.edge_vertices[e][0]), b = id(conn_.edge_vertices[e][1]);
-      const Index ra = a == kInvalidIndex ? kInvalidIndex : uf.find(a);
-      const Index rb = b == kInvalidIndex ? kInvalidIndex : uf.find(b);
+      const Index ra = a == kInvalidIndex ? outside + clusters_->uf.find(conn_.edge_vertices[e][0]) : uf.find(a);
+      const Index rb = b == kInvalidIndex ? outside + clusters_->uf.find(conn_.edge_vertices[e][1]) : uf.find(b);
       if (ra == rb) continue;
-      if (ra != kInvalidIndex) ++valence[ra];
-      if (rb != kInvalidIndex) ++valence[rb];
+      if (ra < outside) links.emplace_back(ra, rb);
+      if (rb < outside) links.emplace_back(rb, ra);
     }
+    std::sort(links.begin(), links.end());
+    links.erase(std::unique(links.begin(), links.end()), links.end());
+    std::vector<Index> valence(sorted.size(), 0);
+    for (const auto& link : links) ++valence[link.first];
     for (Index e : path) kept_[e] = 0;
     if (parts < 2) return clusters_->valence[clusters_->uf.find(verts[0])];
     return *std::max_element(valence.begin(), valence.end());

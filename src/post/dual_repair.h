@@ -68,8 +68,9 @@ DualRepairResult repair_dual_graph(const PolyMesh& mesh, const Connectivity& con
                                    const std::vector<std::uint8_t>& edge_kept,
                                    const DualRepairParams& params = {});
 
-/// Valence of every vertex cluster a selection produces: the number of kept edges with exactly
-/// one endpoint in the cluster. Indexed by vertex (all vertices of a cluster share the value).
+/// Valence of every vertex cluster a selection produces: the number of distinct other clusters
+/// its kept edges lead to (the valence of the merged output vertex; kept edges that join the
+/// same two clusters become one output edge). Indexed by vertex (a cluster shares the value).
 std::vector<Index> cluster_valences(const Connectivity& conn, const std::vector<std::uint8_t>& edge_kept);
 
 }  // namespace quadlod

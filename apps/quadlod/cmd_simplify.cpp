@@ -1,0 +1,116 @@
+// `quadlod simplify INPUT -o OUTPUT (--ratio R | --faces N) ...`: the whole pipeline.
+#include "commands.h"
+
+#include "quadlod/io.h"
+#include "quadlod/simplify.h"
+#include "util/progress.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace quadlod::cli {
+
+namespace {
+
+struct SimplifyCliOptions {
+  std::string input, output, report;
+  double ratio = 0.0;
+  std::uint64_t faces = 0;
+  SimplifyOptions pipeline;
+  std::string formulation = "fast";
+  bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
+};
+
+}  // namespace
+
+Command add_simplify(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<SimplifyCliOptions>();
+  CLI::App* sub = app.add_subcommand("simplify", "Reduce a quad-dominant mesh, keeping its edge loops");
+  sub->add_option("INPUT", opt->input, "Input mesh (.obj, .ply, .off)")->required();
+  sub->add_option("-o,--output", opt->output, "Output mesh (.obj, .ply, .off)")->required();
+  auto* ratio = sub->add_option("--ratio", opt->ratio, "Target as a fraction of the input's triangle-equivalents")
+                    ->check(CLI::Range(1e-6, 1.0))
+                    ->group("Target (one of)");
+  auto* faces = sub->add_option("--faces", opt->faces, "Target triangle-equivalents (quad = 2, k-gon = k-2)")
+                    ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40))
+                    ->group("Target (one of)");
+  ratio->excludes(faces);
+  faces->excludes(ratio);
+  SimplifyOptions& p = opt->pipeline;
+  sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget in seconds (0 = greedy selection only)")
+      ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Solver");
+  sub->add_option("--threads", p.threads, "Solver threads (0 = all cores)")
+      ->check(CLI::Range(0, 256))->capture_default_str()->group("Solver");
+  sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Solver");
+  sub->add_option("--formulation", opt->formulation, "fast, or exact (the paper's model as written)")
+      ->check(CLI::IsMember({"fast", "exact"}))->capture_default_str()->group("Solver");
+  sub->add_option("--epsilon-n", p.epsilon_n, "Eq. 2 slack on the target")
+      ->check(CLI::Range(0.0, 0.5))->capture_default_str()->group("Paper parameters");
+  sub->add_option("--epsilon-theta", p.epsilon_theta_deg, "Segmentation breakpoint angle, degrees (§3.2.2)")
+      ->check(CLI::Range(1.0, 180.0))->capture_default_str()->group("Paper parameters");
+  sub->add_option("--lambda-geo", p.lambda_geo, "Eq. 9 weight of collapsed geometric clusters")
+      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_geo()))->group("Paper parameters");
+  sub->add_option("--lambda-edge", p.lambda_edge, "Eq. 9 weight of edge importance")
+      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_edge()))->group("Paper parameters");
+  sub->add_option("--max-hausdorff", p.max_hausdorff, "Bound on moved vertices' distance, relative to the bbox diagonal (0 = off)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group("Guarantees");
+  sub->add_flag("--no-consistency", opt->no_consistency, "Ablation: drop Eq. 4")->group("Ablations");
+  sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
+  sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
+  sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
+  sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
+  return {sub, [opt, ratio, faces, &global]() -> int {
+            if (ratio->count() == 0 && faces->count() == 0) {
+              std::fprintf(stderr, "quadlod simplify: give a target: --ratio R or --faces N\n");
+              return kExitUsage;
+            }
+            for (const std::string& out : {opt->output, opt->report})
+              if (!out.empty() && same_file(opt->input, out))
+                return fail(out + ": refusing to overwrite the input");
+            if (!opt->report.empty() && same_file(opt->output, opt->report))
+              return fail(opt->report + ": the report and the output are the same file");
+            MeshFormat format;
+            if (!format_from_path(opt->output, format))
+              return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
+            Stopwatch clock;
+            const ReadResult in = read_mesh(opt->input);
+            if (!in.ok()) return fail(in.error);
+            const double read_seconds = clock.seconds();
+            SimplifyOptions p = opt->pipeline;
+            p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
+            p.target_tri_equivalent = opt->faces;
+            p.exact_formulation = opt->formulation == "exact";
+            p.consistency = !opt->no_consistency;
+            p.segmentation = !opt->no_segmentation;
+            p.geometry = !opt->no_geometry;
+            p.dual_repair = !opt->no_dual;
+            p.progress = !global.quiet;
+            SimplifyResult r = simplify(in.mesh, p);
+            if (!r.ok()) return fail(opt->input + ": " + r.error);
+            clock = Stopwatch();
+            const WriteResult written = write_mesh(r.mesh, opt->output);
+            if (!written.ok()) return fail(written.error);
+            const double write_seconds = clock.seconds();
+            r.report["input"] = opt->input;
+            r.report["output"] = opt->output;
+            r.report["read_seconds"] = read_seconds;
+            r.report["write_seconds"] = write_seconds;
+            if (!opt->report.empty()) {
+              const WriteResult rep = write_file_atomically(opt->report, r.report.dump(2) + "\n");
+              if (!rep.ok()) return fail(rep.error);
+            }
+            const auto& rep = r.report;
+            std::printf(
+                "simplify: target %llu, achieved %llu (%+.1f%%), %u quads, %u tris, %u n-gons; "
+                "analysis %.2f s, select %.2f s, dual %.2f s, collapse %.2f s, total %.2f s\n",
+                static_cast<unsigned long long>(r.target), static_cast<unsigned long long>(r.achieved),
+                100.0 * rep["deviation"].get<double>(), r.quads, r.triangles, r.ngons,
+                rep["analysis"]["seconds"].get<double>(), rep["selection"]["seconds"].get<double>(),
+                rep["dual_repair"]["seconds"].get<double>(), rep["collapse"]["seconds"].get<double>(),
+                read_seconds + rep["seconds"].get<double>() + write_seconds);
+            if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
+            return kExitOk;
+          }};
+}
+
+}  // namespace quadlod::cli

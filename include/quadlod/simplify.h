@@ -1,0 +1,78 @@
+// quadlod — quad-dominant mesh reduction, the whole pipeline of the paper's Fig. 2:
+//
+//   input ─► connectivity ─► analysis (poly-chords §3.1, segments §3.2.2, clusters §3.2.3–4)
+//         ─► edge selection (ILP §3.2, Eqs. 1–9) ─► dual repair (§3.3.1)
+//         ─► cluster collapse (§3.3.2) ─► output
+//
+// Sizes are triangle-equivalents, as the paper counts faces: a triangle is 1, a quad 2, a
+// k-gon k − 2. The options here are the knobs a user turns; every stage has more parameters
+// with documented defaults in its own header under src/ (docs/parameters.md lists them).
+#pragma once
+
+#include "quadlod/mesh.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace quadlod {
+
+struct SimplifyOptions {
+  /// Target as a fraction of the input's triangle-equivalents, in (0, 1]; or, when
+  /// `target_tri_equivalent` > 0, that absolute count (which then wins).
+  double ratio = 0.5;
+  std::uint64_t target_tri_equivalent = 0;
+
+  // --- the paper's parameters (defaults: the paper's values where it gives one) ---------------
+  double epsilon_n = 0.03;          ///< Eq. 2 slack
+  double epsilon_theta_deg = 60.0;  ///< §3.2.2 breakpoint angle (π/3)
+  double lambda_geo = -1.0;         ///< Eq. 9; < 0 = the measured default (docs/parameters.md)
+  double lambda_edge = -1.0;        ///< Eq. 9; < 0 = the measured default
+
+  // --- solver -----------------------------------------------------------------------------------
+  double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only
+  int threads = 1;                  ///< solver threads; 0 = all cores
+  std::uint32_t seed = 1;
+  bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
+  std::string solver = "cbc";
+
+  // --- ablations (paper Table 2) ----------------------------------------------------------------
+  bool consistency = true;   ///< Eq. 4
+  bool segmentation = true;  ///< §3.2.2
+  bool geometry = true;      ///< Eqs. 6–8
+  bool dual_repair = true;   ///< §3.3.1
+
+  // --- guarantees -------------------------------------------------------------------------------
+  /// Bound on the distance of moved vertices from the input, relative to the bounding-box
+  /// diagonal; <= 0 = no bound.
+  double max_hausdorff = 0.0;
+
+  /// Progress lines on stderr (stage, percent, elapsed).
+  bool progress = false;
+};
+
+struct SimplifyResult {
+  PolyMesh mesh;       ///< the reduced mesh (the input unchanged when nothing is to do)
+  std::string error;   ///< non-empty: the input could not be processed (mesh is empty)
+  std::string note;    ///< non-empty: the result is not what was asked for, and why
+  std::uint64_t input_tri_equivalent = 0;
+  std::uint64_t target = 0;
+  std::uint64_t achieved = 0;  ///< tri-equivalents of `mesh`
+  Index quads = 0, triangles = 0, ngons = 0;
+  /// Everything measured on the way: per-stage seconds, analysis counts, model sizes, solver
+  /// status / objective / bound / gap, repair and collapse statistics.
+  nlohmann::json report;
+  bool ok() const { return error.empty(); }
+};
+
+/// Reduces `input` to about the target size. Never throws for bad input: `error` says what is
+/// wrong ("vertex 12 (1-based) has a non-finite coordinate").
+SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options);
+
+/// The measured defaults of λ_geo and λ_edge (see docs/parameters.md).
+double default_lambda_geo();
+double default_lambda_edge();
+
+}  // namespace quadlod
