@@ -50,7 +50,17 @@ bool format_from_path(const std::filesystem::path& path, MeshFormat& format);
 /// Reads a mesh; the format comes from the extension. Rejects: unreadable/missing files,
 /// truncated or malformed records, non-finite coordinates, out-of-range or zero indices, faces
 /// with fewer than 3 corners, repeated vertices in a face (see ReadOptions), an empty mesh
-/// (no faces).
+/// (no faces). A failed read returns an empty mesh.
+///
+/// What each format fills in:
+///   * OBJ: positions, vertex_colors (`v x y z r g b`), the uv/normal pools and per-corner
+///     indices exactly as the `f` records give them, o/g/usemtl/s tags and mtllib lines. The
+///     per-corner and per-face arrays exist only if the file uses them (has_uvs() is meaningful).
+///     Positive indices may refer forward; negative ones are relative to what precedes them.
+///   * PLY: positions; per-vertex normals and UVs become pools indexed by the corner's vertex;
+///     a per-face `texcoord` list (MeshLab, 2 floats per corner) becomes one pool entry per
+///     corner and wins over per-vertex UVs; red/green/blue become vertex_colors in [0,1].
+///   * OFF: positions and faces (ST/C/N/4 variants are read, their extra values skipped).
 ReadResult read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 ReadResult read_obj(const std::filesystem::path& path, const ReadOptions& options = {});
 ReadResult read_ply(const std::filesystem::path& path, const ReadOptions& options = {});
@@ -62,7 +72,15 @@ ReadResult parse_obj(std::string_view text, const std::string& name, const ReadO
 /// Writes a mesh; the format comes from the extension. The file appears atomically: data goes
 /// to a temporary file in the target directory which is renamed over the target only after a
 /// complete, flushed write, so a failure leaves no partial file behind. Callers that must not
-/// overwrite an input compare paths before calling (the CLI does).
+/// overwrite an input compare paths before calling (the CLI does). A mesh failing
+/// check_layout() is refused.
+///
+///   * OBJ: read → write → read reproduces the PolyMesh exactly when `precision` covers the
+///     input's digits (17 always does); tags are emitted where they change between faces.
+///   * PLY: float x y z (so coordinates round to float), nx ny nz only when every vertex has one
+///     normal shared by all its corners, uchar colours, per-corner UVs as a `texcoord` list.
+///     Face tags have no PLY form and are dropped.
+///   * OFF: positions and faces only.
 WriteResult write_mesh(const PolyMesh& mesh, const std::filesystem::path& path,
                        const WriteOptions& options = {});
 WriteResult write_obj(const PolyMesh& mesh, const std::filesystem::path& path,

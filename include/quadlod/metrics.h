@@ -1,0 +1,123 @@
+// quadlod — evaluation metrics of `quadlod eval INPUT OUTPUT` (paper §4.1 and beyond).
+//
+// The exact definitions, formulas and edge-case rules live in docs/metrics.md; this header is
+// their contract. In short:
+//   * both meshes are mapped by p ↦ s·(p − c), s = 1 / (longest side of the INPUT's bounding
+//     box), c = the input bbox centre, so every distance below is in units of the input's
+//     longest bbox side (paper §4.1: "normalized to a unit bounding box");
+//   * distances are exact point-to-surface distances (BVH over the fan triangulation) measured
+//     from area-weighted random surface samples (plus the mesh vertices, for Hausdorff only);
+//   * QPR (Knodt 2025) with a documented rule for zero counts (`qpr_rule`);
+//   * PCCD = Chamfer distance between the poly-chords' medial curves, sampled by arc length;
+//   * flow deviation: angle between output quad edge directions and the closest input quad's.
+// Everything is deterministic for a fixed seed and independent of the thread count.
+#pragma once
+
+#include "quadlod/mesh.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace quadlod {
+
+struct EvalParams {
+  /// Surface samples per direction (N). 200000 gives a Chamfer standard error well below the
+  /// paper's smallest reported values on the corpus meshes.
+  std::uint64_t samples = 200000;
+  /// Medial-curve samples per direction for PCCD (evenly spaced by arc length).
+  std::uint64_t curve_samples = 100000;
+  /// Seed of the sample generator (xoshiro256**; input stream 0, output stream 1).
+  std::uint64_t seed = 1;
+  /// Flow deviation only compares an output quad with an input quad whose planes are within
+  /// this angle (unoriented normals); beyond it the sample does not count as covered.
+  double flow_max_normal_angle_deg = 60.0;
+  /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
+  /// Results do not depend on it.
+  unsigned threads = 0;
+};
+
+/// Face counts of one mesh as QPR sees them (tris = 3 corners, quads = 4, n-gons = 5+).
+struct FaceCounts {
+  std::uint64_t faces = 0;
+  std::uint64_t tris = 0;
+  std::uint64_t quads = 0;
+  std::uint64_t ngons = 0;
+  std::uint64_t tri_equivalent = 0;  ///< quad = 2, k-gon = k − 2 (paper §3.1)
+};
+
+struct EvalResult {
+  /// Empty on success; otherwise why no metric could be computed (then all metrics are NaN/0).
+  std::string error;
+  bool ok() const { return error.empty(); }
+
+  // --- normalisation ---------------------------------------------------------------------------
+  double scale = 0.0;       ///< s = 1 / longest side of the input bbox (original units → metric units)
+  double area_in = 0.0;     ///< surface area of the input after scaling
+  double area_out = 0.0;    ///< surface area of the output after scaling
+
+  // --- geometric distances (normalised units) ----------------------------------------------------
+  double chamfer = 0.0;              ///< ½(mean_in_to_out + mean_out_to_in), plain distances
+  double chamfer_sq = 0.0;           ///< ½(mean of d² in→out + mean of d² out→in)
+  double mean_in_to_out = 0.0;       ///< mean over input samples of d(a, M_out)
+  double mean_out_to_in = 0.0;       ///< mean over output samples of d(b, M_in)
+  double hausdorff = 0.0;            ///< max(hausdorff_in_to_out, hausdorff_out_to_in)
+  double hausdorff_in_to_out = 0.0;  ///< max over input samples and input vertices
+  double hausdorff_out_to_in = 0.0;  ///< max over output samples and output vertices
+
+  // --- quad preservation ---------------------------------------------------------------------------
+  double qpr = 0.0;                 ///< Quad Preservation Ratio (Knodt 2025), see qpr_rule
+  std::string qpr_rule;             ///< which case of docs/metrics.md §4 produced qpr
+  double quad_fraction_in = 0.0;    ///< quads / faces of the input
+  double quad_fraction_out = 0.0;   ///< quads / faces of the output
+  FaceCounts counts_in;
+  FaceCounts counts_out;
+
+  // --- poly-chord Chamfer distance (PCCD, paper §4.1) -----------------------------------------
+  double pccd = 0.0;            ///< ½(pccd_in_to_out + pccd_out_to_in) when defined
+  bool pccd_defined = false;    ///< false when either mesh has no poly-chord (then see metrics.md §5)
+  double pccd_in_to_out = 0.0;  ///< mean distance from input curve samples to the output curves
+  double pccd_out_to_in = 0.0;
+  std::uint64_t chords_in = 0;
+  std::uint64_t chords_out = 0;
+  double curve_length_in = 0.0;   ///< total medial-curve length (normalised units)
+  double curve_length_out = 0.0;
+
+  // --- flow deviation (beyond the paper) ---------------------------------------------------------
+  double flow_deviation_deg = 0.0;      ///< mean over covered output samples; NaN when none
+  double flow_deviation_p90_deg = 0.0;  ///< 90th percentile (nearest rank); NaN when none
+  double flow_coverage = 0.0;           ///< covered output samples / all output samples
+
+  // --- provenance -----------------------------------------------------------------------------------
+  std::uint64_t seed = 0;
+  std::uint64_t samples_in = 0;          ///< surface samples drawn on the input
+  std::uint64_t samples_out = 0;
+  std::uint64_t vertex_samples_in = 0;   ///< input vertices used by a face (Hausdorff only)
+  std::uint64_t vertex_samples_out = 0;
+  std::uint64_t curve_samples_in = 0;
+  std::uint64_t curve_samples_out = 0;
+  std::uint64_t flow_samples = 0;        ///< covered output samples
+  unsigned threads = 0;                  ///< worker threads used
+  double seconds = 0.0;                  ///< wall time of evaluate()
+  double seconds_distance = 0.0;         ///< sampling + BVH + surface distance queries
+  double seconds_pccd = 0.0;             ///< chords + curve sampling + curve distances
+};
+
+/// Computes every metric of `output` against `input` (docs/metrics.md). Preconditions: both
+/// meshes pass PolyMesh::check_layout(); on a violation, a non-finite coordinate, an input with a
+/// zero-size bounding box, or a mesh with zero surface area, returns a result whose `error` says
+/// which (no exception). Deterministic for fixed params.seed; independent of params.threads.
+EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalParams& params = {});
+
+/// QPR from face counts alone (docs/metrics.md §4); `rule` receives the case name.
+double quad_preservation_ratio(const FaceCounts& in, const FaceCounts& out, std::string* rule = nullptr);
+
+/// Face counts of a mesh (tris, quads, n-gons, triangle equivalents).
+FaceCounts count_faces(const PolyMesh& mesh);
+
+/// The result as a JSON object; NaN and ±inf become null. Keys are the field names above
+/// (counts flattened as quads_in, tris_out, …).
+nlohmann::json to_json(const EvalResult& result);
+
+}  // namespace quadlod

@@ -1,0 +1,424 @@
+// quadlod — COIN-OR CBC backend for ilp::Model (the only file that includes COIN headers).
+//
+// We run CBC's standalone driver (CbcMain0/CbcMain1, the code behind the `cbc` executable) on an
+// OsiClpSolverInterface loaded in bulk from the model's CSR matrix, rather than calling
+// CbcModel::branchAndBound ourselves: the driver adds CglPreProcess, the default cut generators
+// and the primal heuristics (feasibility pump, RINS, diving, ...), which a bare CbcModel lacks and
+// which decide whether a time-limited solve finds anything good.
+//
+// What the Debian 12 build (coinor-libcbc 2.10.8+ds1-1) supports — checked on this machine:
+//   * Threads: yes. libCbc is built with CBC_THREAD (it links pthread_create, the driver accepts
+//     "-threads N" and logs per-thread statistics). N > 1 makes the tree search parallel and,
+//     with a time limit, non-repeatable; we pass "-threads" only for N > 1.
+//   * Wall-clock limit: "-timeMode elapsed" makes "-sec" count wall time (the default counts
+//     CPU time, which drifts from the caller's budget both with threads and on a loaded
+//     machine). "-sec" does not cover the driver's root LP solve, which on a random 75k-row,
+//     87k-column model of the paper's shape took 9 s CPU with dual simplex (primal: 71 s; the
+//     Debian Clp barrier crashed) and made a 10 s solve of a 300k-row model last 416 s. So the
+//     root LP also gets Clp's own wall-clock limit (a duration counted from the start of that
+//     solve), lifted again in the driver callback once it is done.
+//   * Pre-processed model size: the driver's callback at whereFrom == 3 ("just before
+//     branchAndBound") receives the model whose solver is the CglPreProcess output, so its
+//     rows/columns/elements are the pre-solved size. The driver skips pre-processing when the
+//     time limit is already used up (then the size is the original one). Without
+//     branch-and-bound (pure LPs, root LP cut short, pre-processing proving infeasibility) that
+//     callback never comes and we report -1.
+//   * MIP start: CbcModel::setMIPStart takes (column name, value) pairs; the driver maps them
+//     through pre-processing, fixes the integers, re-solves the LP for the continuous columns
+//     and, if that works, installs the result as incumbent before branch-and-bound. We detect
+//     acceptance as "an incumbent exists at whereFrom == 3", when no heuristic has run yet.
+//     (The driver's "MIPStart provided solution" message is not reliably delivered to a custom
+//     message handler: the driver hands the handler to Clp, whose log level then silences it.)
+//   * Bogus infeasibility: CglPreProcess can report "infeasible" for feasible models — when the
+//     time limit interrupts it (reproduced here with -sec 0.005 on a 300-column knapsack) and in
+//     known bugs (coin-or/Cbc issues 466, 737, 740, 747). A claim made by pre-processing, not
+//     confirmed by an infeasible root LP, is re-checked by solving again with "-preprocess off"
+//     on the remaining time; a feasible initial solution overrides it in any case (solver.cpp).
+//   * Re-entrancy: the driver keeps parser state in globals (CbcOrClpParam.cpp:
+//     CbcOrClpRead_mode, CbcOrClpEnvironmentIndex, ...), so CBC runs are serialised process-wide.
+//   * Output: with noPrinting_ and "-log 0 -slog 0" nothing is printed. With log_level >= 1 CBC
+//     prints its own log to stdout (the driver creates message handlers for its internal models
+//     that we cannot redirect).
+#include "ilp/solver.h"
+
+#include <CbcEventHandler.hpp>
+#include <CbcModel.hpp>
+#include <CbcSolver.hpp>
+#include <CoinError.hpp>
+#include <CoinPackedMatrix.hpp>
+#include <OsiClpSolverInterface.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace quadlod::ilp {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Shortest round-trip text of a double, for CBC's command line (std::to_string would print
+// 1e-7 as "0.000000").
+std::string arg(double v) {
+  char buf[32];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof(buf), v);
+  return ec == std::errc{} ? std::string(buf, end) : std::string("0");
+}
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// COIN's "infinity" is a large finite number.
+double to_coin(double v) {
+  if (v == kInf) return COIN_DBL_MAX;
+  if (v == -kInf) return -COIN_DBL_MAX;
+  return v;
+}
+double from_coin(double v) {
+  if (v >= 1e50) return kInf;  // CBC reports "no bound / no incumbent" as ~1e50 .. COIN_DBL_MAX
+  if (v <= -1e50) return -kInf;
+  return v;
+}
+
+std::mutex g_cbc_mutex;  // see "Re-entrancy" above
+
+// State shared by the driver callback and the event handlers of one CBC run.
+struct RunContext {
+  const SolveParams* params = nullptr;
+  Clock::time_point t0;
+
+  // Written by the driver callback (the calling thread only).
+  bool root_lp_infeasible = false;
+  bool root_lp_stopped = false;  // root LP neither optimal nor proven infeasible/unbounded
+  bool reached_branch_and_bound = false;
+  bool incumbent_before_search = false;
+  ModelSize presolved;
+
+  // Progress reporting; the event handlers of CBC's worker threads share it.
+  std::mutex progress_mutex;
+  double best_reported = kInf;
+};
+
+// CbcMain1's callback takes no user pointer; the driver calls it on the thread that called
+// CbcMain1, so a thread-local pointer reaches the right run.
+thread_local RunContext* t_run = nullptr;
+
+int driver_callback(CbcModel* model, int where_from) {
+  RunContext* run = t_run;
+  if (!run || !model) return 0;
+  const OsiSolverInterface* solver = model->solver();
+  if (where_from == 1 && solver) {
+    // After the root LP of the original model: an infeasible LP is a trustworthy proof.
+    run->root_lp_infeasible = solver->isProvenPrimalInfeasible();
+    run->root_lp_stopped = !solver->isProvenOptimal() && !solver->isProvenPrimalInfeasible() &&
+                           !solver->isProvenDualInfeasible();
+    // The wall-clock limit we gave Clp was for this root solve only (see run_cbc); lift it so
+    // that the LPs of branch-and-bound are governed by CBC's own limit.
+    if (auto* clp = dynamic_cast<OsiClpSolverInterface*>(model->solver()))
+      clp->getModelPtr()->setMaximumWallSeconds(-1.0);
+  } else if (where_from == 3 && solver) {
+    run->reached_branch_and_bound = true;
+    run->presolved = {solver->getNumRows(), solver->getNumCols(),
+                      static_cast<std::int64_t>(solver->getNumElements()), solver->getNumIntegers()};
+    run->incumbent_before_search = model->bestSolution() != nullptr;
+  }
+  return 0;  // 0 = carry on
+}
+
+// Reports incumbent improvements. CBC clones the handler into every model it creates (the
+// pre-processed one, one per worker thread), all pointing at the same RunContext.
+class ProgressHandler : public CbcEventHandler {
+ public:
+  explicit ProgressHandler(RunContext* run) : run_(run) {}
+  ProgressHandler(const ProgressHandler&) = default;
+  ProgressHandler& operator=(const ProgressHandler&) = default;
+  CbcEventHandler* clone() const override { return new ProgressHandler(*this); }
+
+  CbcAction event(CbcEvent which) override {
+    if (!run_ || !model_ || !run_->params->on_progress) return noAction;
+    // "heuristicSolution" fires before the new incumbent is stored, so we poll the stored
+    // incumbent on every event that can follow an improvement and report when it changed.
+    if (which != solution && which != heuristicSolution && which != node && which != treeStatus &&
+        which != endSearch)
+      return noAction;
+    const double obj = from_coin(model_->getObjValue());
+    if (!std::isfinite(obj)) return noAction;
+    std::lock_guard lock(run_->progress_mutex);
+    if (!(obj < run_->best_reported - 1e-9 * std::max(1.0, std::abs(obj)))) return noAction;
+    run_->best_reported = obj;
+    Progress p{obj, from_coin(model_->getBestPossibleObjValue()), seconds_since(run_->t0)};
+    try {
+      run_->params->on_progress(p);
+    } catch (...) {
+      // The contract says the callback must not throw; an exception must not unwind through
+      // CBC's C-style stack frames either.
+    }
+    return noAction;
+  }
+
+ private:
+  RunContext* run_ = nullptr;
+};
+
+// The model in COIN form, built once per solve and loaded into a fresh solver for each run.
+struct CoinProblem {
+  CoinPackedMatrix matrix;
+  std::vector<double> col_lower, col_upper, objective, row_lower, row_upper;
+  std::vector<int> integers;
+};
+
+CoinProblem to_coin(const Model& model) {
+  CoinProblem p;
+  const Col n = model.num_cols();
+  const Row m = model.num_rows();
+  // Row-major CSR straight from the model: one bulk load, no per-row calls.
+  std::vector<CoinBigIndex> starts(model.row_starts().begin(), model.row_starts().end());
+  std::vector<int> cols(model.matrix_cols().begin(), model.matrix_cols().end());
+  const auto coefs = model.matrix_coefs();
+  p.matrix = CoinPackedMatrix(false /*row-ordered*/, static_cast<int>(n), static_cast<int>(m),
+                              static_cast<CoinBigIndex>(coefs.size()), coefs.data(), cols.data(),
+                              starts.data(), nullptr);
+  p.col_lower.resize(n);
+  p.col_upper.resize(n);
+  p.objective.assign(model.objectives().begin(), model.objectives().end());
+  for (Col c = 0; c < n; ++c) {
+    p.col_lower[c] = to_coin(model.col_lower(c));
+    p.col_upper[c] = to_coin(model.col_upper(c));
+    if (model.is_integer(c)) p.integers.push_back(static_cast<int>(c));
+  }
+  p.row_lower.resize(m);
+  p.row_upper.resize(m);
+  for (Row r = 0; r < m; ++r) {
+    p.row_lower[r] = to_coin(model.row_lower(r));
+    p.row_upper[r] = to_coin(model.row_upper(r));
+  }
+  return p;
+}
+
+struct RunOutcome {
+  SolveStatus status = SolveStatus::Error;
+  std::vector<double> solution;
+  double best_bound = -kInf;
+  std::int64_t nodes = 0, iterations = 0;
+  bool reached_branch_and_bound = false;
+  bool root_lp_infeasible = false;
+  bool root_lp_stopped = false;
+  bool incumbent_before_search = false;
+  ModelSize presolved;
+  std::string error;  // CBC threw
+};
+
+RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolveParams& params,
+                   double time_limit, bool preprocess, bool use_start, RunContext& run) {
+  RunOutcome out;
+  const Col n = model.num_cols();
+
+  OsiClpSolverInterface lp;
+  lp.messageHandler()->setLogLevel(0);
+  lp.loadProblem(problem.matrix, problem.col_lower.data(), problem.col_upper.data(),
+                 problem.objective.data(), problem.row_lower.data(), problem.row_upper.data());
+  if (!problem.integers.empty())
+    lp.setInteger(problem.integers.data(), static_cast<int>(problem.integers.size()));
+  // Osi subtracts its offset: objective = c·x - OsiObjOffset.
+  lp.setDblParam(OsiObjOffset, -model.objective_offset());
+  // CBC's "-sec" only governs branch-and-bound; the driver's root LP solve ignores it and can
+  // take longer than the whole budget on big models. Clp's own wall-clock limit bounds it.
+  if (std::isfinite(time_limit)) lp.getModelPtr()->setMaximumWallSeconds(time_limit);
+
+  CbcModel cbc(lp);
+  CbcSolverUsefulData data;
+  data.noPrinting_ = params.log_level == 0;
+  data.useSignalHandler_ = false;  // never touch the host's SIGINT handling
+  CbcMain0(cbc, data);
+
+  ProgressHandler progress(&run);
+  cbc.passInEventHandler(&progress);  // CBC keeps a clone
+
+  if (use_start) {
+    // Names are CBC's defaults ("C0000000", ...): unique by construction, unlike user names.
+    const std::vector<double>& start = model.initial_solution();
+    std::vector<std::pair<std::string, double>> named(n);
+    for (Col c = 0; c < n; ++c) named[c] = {cbc.solver()->getColName(static_cast<int>(c)), start[c]};
+    cbc.setMIPStart(named);
+  }
+
+  const std::string log = std::to_string(params.log_level);
+  const std::string slog = std::to_string(std::max(0, params.log_level - 1));
+  const std::string threads = std::to_string(backend::resolve_threads(params));
+  const std::string seconds = arg(time_limit);
+  const std::string gap = arg(params.relative_gap);
+  // CBC reads seed 0 as "seed from the clock"; keep runs repeatable.
+  const std::string seed = std::to_string(std::max<std::uint32_t>(1, params.seed % INT_MAX));
+  std::vector<const char*> argv = {"quadlod", "-log", log.c_str(), "-slog", slog.c_str(),
+                                   "-timeMode", "elapsed", "-ratioGap", gap.c_str(),
+                                   "-randomCbcSeed", seed.c_str()};
+  if (std::isfinite(time_limit)) argv.insert(argv.end(), {"-sec", seconds.c_str()});
+  if (backend::resolve_threads(params) > 1) argv.insert(argv.end(), {"-threads", threads.c_str()});
+  if (!preprocess) argv.insert(argv.end(), {"-preprocess", "off"});
+  argv.insert(argv.end(), {"-solve", "-quit"});
+
+  run.root_lp_infeasible = run.root_lp_stopped = run.reached_branch_and_bound = false;
+  run.incumbent_before_search = false;
+  run.presolved = {};
+  t_run = &run;
+  try {
+    CbcMain1(static_cast<int>(argv.size()), argv.data(), cbc, driver_callback, data);
+  } catch (const CoinError& e) {
+    out.error = "CBC threw " + e.className() + "::" + e.methodName() + ": " + e.message();
+  } catch (const std::exception& e) {
+    out.error = std::string("CBC threw: ") + e.what();
+  } catch (...) {
+    out.error = "CBC threw an unknown exception";
+  }
+  t_run = nullptr;
+
+  out.reached_branch_and_bound = run.reached_branch_and_bound;
+  out.root_lp_infeasible = run.root_lp_infeasible;
+  out.root_lp_stopped = run.root_lp_stopped;
+  out.incumbent_before_search = run.incumbent_before_search;
+  out.presolved = run.presolved;
+  if (!out.error.empty()) return out;
+
+  out.nodes = cbc.getNodeCount();
+  out.iterations = cbc.getIterationCount();
+  // An interrupted dual simplex leaves an objective value that is not a proven bound.
+  out.best_bound = run.root_lp_stopped ? -kInf : from_coin(cbc.getBestPossibleObjValue());
+  const double* best = cbc.bestSolution();
+  if (best) out.solution.assign(best, best + n);
+
+  const OsiSolverInterface* solver = cbc.solver();
+  if (problem.integers.empty() && cbc.status() == -1 && solver) {
+    // Pure LP: the driver solved it with Clp and never started branch-and-bound.
+    if (solver->isProvenOptimal()) {
+      out.status = SolveStatus::Optimal;
+      if (out.solution.empty()) out.solution.assign(solver->getColSolution(), solver->getColSolution() + n);
+      out.best_bound = solver->getObjValue();
+    } else if (solver->isProvenPrimalInfeasible()) {
+      out.status = SolveStatus::Infeasible;
+    } else if (solver->isProvenDualInfeasible()) {
+      out.status = SolveStatus::Unbounded;
+    } else {
+      out.status = out.solution.empty() ? SolveStatus::NoSolution : SolveStatus::Feasible;
+    }
+  } else if (cbc.isProvenOptimal() && !out.solution.empty()) {
+    out.status = SolveStatus::Optimal;
+  } else if (cbc.isProvenInfeasible()) {
+    out.status = SolveStatus::Infeasible;
+  } else if (cbc.isContinuousUnbounded()) {
+    out.status = SolveStatus::Unbounded;
+  } else if (!out.solution.empty()) {
+    out.status = SolveStatus::Feasible;
+  } else if (cbc.isAbandoned()) {
+    out.status = SolveStatus::Error;
+    out.error = "CBC abandoned the search (numerical difficulties)";
+  } else {
+    out.status = SolveStatus::NoSolution;  // time (or node) limit before any incumbent
+  }
+  return out;
+}
+
+class CbcBackend final : public Solver {
+ public:
+  std::string name() const override { return "cbc"; }
+  SolveResult solve(const Model& model, const SolveParams& params) override;
+};
+
+SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
+  const Clock::time_point t0 = Clock::now();
+  SolveResult result;
+  result.backend = name();
+  result.call = CallStatus::Ok;
+  result.status = SolveStatus::Error;
+
+  const bool has_start = model.has_initial_solution();
+  const bool start_fits = has_start && model.initial_solution().size() == model.num_cols();
+  result.start = !has_start ? StartStatus::NotGiven : start_fits ? StartStatus::Unknown : StartStatus::WrongSize;
+  if (result.start == StartStatus::WrongSize)
+    backend::note(result, CallStatus::Warning,
+                  "initial solution has " + std::to_string(model.initial_solution().size()) +
+                      " values for " + std::to_string(model.num_cols()) + " columns; ignored");
+
+  const auto fail = [&](const std::string& why) {
+    backend::note(result, CallStatus::Error, why);
+    result.status = SolveStatus::Error;
+    backend::finish(model, params, result);
+    result.seconds = seconds_since(t0);
+    return result;
+  };
+  if (std::string bad = backend::check_params(params); !bad.empty()) return fail("invalid parameters: " + bad);
+  if (model.num_cols() == 0) return fail("model has no columns");
+
+  CoinProblem problem;
+  try {
+    problem = to_coin(model);
+  } catch (const std::exception& e) {
+    return fail(std::string("building the CBC model failed: ") + e.what());
+  }
+
+  std::lock_guard serialise(g_cbc_mutex);
+  RunContext run;
+  run.params = &params;
+  run.t0 = t0;
+
+  const bool use_start = start_fits && params.start_as_mip_start;
+  if (start_fits && !use_start) result.start = StartStatus::NotUsed;
+  // The budget counts from entry into solve(): converting and loading a big model takes a
+  // noticeable part of it (about 1 s for 1.45M nonzeros).
+  const double budget = std::max(1e-3, params.time_limit_seconds - seconds_since(t0));
+  RunOutcome out = run_cbc(model, problem, params, budget, /*preprocess=*/true, use_start, run);
+  result.presolved = out.presolved;
+  if (use_start && out.reached_branch_and_bound)
+    result.start = out.incumbent_before_search ? StartStatus::Accepted : StartStatus::Rejected;
+
+  if (out.status == SolveStatus::Infeasible && !out.reached_branch_and_bound &&
+      !out.root_lp_infeasible && out.error.empty()) {
+    // The claim comes from CglPreProcess alone (see the header comment): check it.
+    const double remaining = params.time_limit_seconds - seconds_since(t0);
+    if (remaining < 0.01) {
+      backend::note(result, CallStatus::Warning,
+                    "CBC pre-processing claimed infeasibility as the time limit ran out; not trusted");
+      out.status = SolveStatus::NoSolution;
+    } else {
+      const std::int64_t nodes = out.nodes, iterations = out.iterations;
+      out = run_cbc(model, problem, params, remaining, /*preprocess=*/false, use_start, run);
+      out.nodes += nodes;
+      out.iterations += iterations;
+      backend::note(result, CallStatus::Warning,
+                    "CBC pre-processing claimed infeasibility; re-solved without pre-processing: " +
+                        std::string(to_string(out.status)));
+      if (use_start && out.reached_branch_and_bound)
+        result.start = out.incumbent_before_search ? StartStatus::Accepted : StartStatus::Rejected;
+    }
+  }
+
+  if (out.root_lp_stopped) {
+    const bool out_of_time = seconds_since(t0) >= 0.95 * params.time_limit_seconds;
+    backend::note(result, out_of_time ? CallStatus::Warning : CallStatus::Error,
+                  std::string(out_of_time ? "the time limit ran out while" : "Clp gave up") +
+                      " solving the root LP relaxation (" + std::to_string(model.num_rows()) +
+                      " rows); CBC found no solution");
+  }
+  if (!out.error.empty()) backend::note(result, CallStatus::Error, out.error);
+  result.status = out.status;
+  result.solution = std::move(out.solution);
+  result.best_bound = out.best_bound;
+  result.nodes = out.nodes;
+  result.iterations = out.iterations;
+  backend::finish(model, params, result);
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+}  // namespace
+
+std::unique_ptr<Solver> make_cbc_solver() { return std::make_unique<CbcBackend>(); }
+
+}  // namespace quadlod::ilp

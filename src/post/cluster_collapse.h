@@ -1,0 +1,190 @@
+// Cluster collapse (paper §3.3.2, "QEM-based Simplification"): turns the solver's one bit per
+// input edge (kept / collapsed) into the reduced mesh.
+//
+//   1. Vertices joined by collapsed edges form clusters (union-find). Each cluster becomes one
+//      vertex, placed at the minimiser of the members' accumulated quadrics: area-weighted face
+//      planes plus the per-edge planes and weights of Knodt 2025 (dihedral-angle weights, heavy
+//      boundary / non-manifold edges), a small pull toward the cluster centroid (Trettner &
+//      Kobbelt 2020 style regulariser) and, optionally, Lindstrom–Turk volume preservation.
+//      docs/cluster_collapse.md says what was taken from Knodt's code and what is ours.
+//   2. Every input face maps its corners through the clusters: runs of corners in one cluster
+//      become one corner, faces with fewer than 3 distinct corners disappear, a face that meets a
+//      cluster at two non-adjacent corners ("pinched") is cut there into simple loops. Quads that
+//      keep four distinct corners stay quads: nothing is ever triangulated.
+//   3. Guarantees, checked on the neighbourhood of every cluster: no new non-manifold edge or
+//      vertex, no new boundary edge, no degenerate (zero-area or repeated-index) face, no new
+//      duplicate face, no face flipped against the input face it comes from, no polygon folded
+//      over at a corner that was convex, and (optional) a bounded one-sided Hausdorff distance.
+//      A cluster that breaks one is *refused*: it is split in two along its longest collapsed
+//      edges (or dissolved entirely after `max_bisect_rounds`), its refused edges become kept,
+//      and the check runs again on the faces that changed, until nothing is violated.
+//      Every refusal is counted by reason together with the triangle-equivalents it kept.
+//
+// Cost: linear in the mesh per round; rounds after the first only revisit the faces around
+// refused clusters.
+#pragma once
+
+#include "mesh/connectivity.h"
+#include "quadlod/mesh.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace quadlod {
+
+struct ClusterCollapseParams {
+  // --- placement: the cluster quadric ---------------------------------------------------------
+  // All weights are dimensionless multipliers of terms that are scaled to the mesh: face planes
+  // carry area (a corner's share of its face's area, split by interior angle), edge planes carry
+  // |edge| · h / 2π with h the mean input edge length, which reproduces Knodt's ratio of edge to
+  // face weight on a regular quad grid (see docs/cluster_collapse.md).
+
+  /// Multiplier of the face-plane quadrics (Garland–Heckbert), >= 0.
+  double face_plane_weight = 1.0;
+  /// Multiplier of all edge-plane quadrics (the plane through an edge that contains the face
+  /// normal, Knodt 2025), >= 0. 0 turns off every edge plane, boundary ones included.
+  double edge_plane_weight = 1.0;
+  /// Weight of a manifold edge's planes is dihedral angle / π (0 flat … 1 folded flat), but at
+  /// least this (Knodt's `min_edge_weight`): keeps flat regions evenly spaced.
+  double min_edge_weight = 0.01;
+  /// Weight of the planes of an open-boundary edge (Knodt: 4): keeps boundaries from shrinking.
+  double boundary_edge_weight = 4.0;
+  /// Weight of the planes of a non-manifold edge (Knodt: 4).
+  double nonmanifold_edge_weight = 4.0;
+  /// Manifold edges with a dihedral angle of at least this many degrees are sharp features and
+  /// get at least `feature_edge_weight`, as heavy as a boundary (our addition; Knodt only uses
+  /// dihedral / π, i.e. 0.5 for a 90° crease). 60° is the paper's ϵ_θ (§3.2.2).
+  double feature_angle_deg = 60.0;
+  double feature_edge_weight = 4.0;
+  /// Pull toward the cluster centroid: each member adds regularization · h² · |x − p_member|².
+  /// Makes the 3×3 system positive definite in flat and straight regions. >= 0.
+  double regularization = 1e-3;
+  /// Minimise subject to Lindstrom–Turk volume preservation (the signed volume swept between the
+  /// members' face planes and the new vertex is zero), as Knodt's code does. Skipped where the
+  /// constraint is degenerate.
+  bool preserve_volume = true;
+  /// Eigenvalues below this fraction of the largest are treated as zero (pseudo-inverse around
+  /// the centroid) when the direct solve is ill-conditioned.
+  double eigen_cutoff = 1e-6;
+  /// A minimiser outside the cluster's bounding box enlarged by this fraction of max(box
+  /// diagonal, h) is not trusted: the best of {centroid, members} by quadric error is used.
+  double bbox_margin = 0.5;
+
+  // --- guarantees -----------------------------------------------------------------------------
+  /// An output face whose normal is more than this many degrees away from the normal of the
+  /// input face it comes from is "flipped" (90 = any reversal of orientation). In (0, 180].
+  double flip_angle_deg = 90.0;
+  /// Also refuse when a corner of an output polygon (>= 4 corners) turns reflex while the input
+  /// corner was convex: the polygon folds over (bow-tie quads; concave quads, which fold when
+  /// split along the wrong diagonal). Reflex = the interior angle, measured against the input
+  /// face's normal, exceeds 180° + corner_fold_tolerance_deg (so nearly straight corners pass).
+  bool check_corner_folds = true;
+  double corner_fold_tolerance_deg = 5.0;
+  /// An output face whose area is at most this times the squared bbox diagonal is degenerate
+  /// (100× the threshold of MeshStats, so outputs pass compute_stats()).
+  double zero_area_epsilon = 1e-12;
+  /// Bound on the one-sided distance, relative to the input bbox diagonal, from a placed cluster
+  /// vertex and from the midpoints of its new edges to unmoved neighbours, to the input faces
+  /// around the cluster. <= 0: no bound.
+  double max_hausdorff = 0.0;
+
+  // --- refinement -----------------------------------------------------------------------------
+  /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
+  /// from then on a refused cluster is dissolved entirely. 0: always dissolve.
+  Index max_bisect_rounds = 8;
+};
+
+/// Why a cluster was refused, in priority order (a cluster with several problems is counted
+/// once, under the first).
+enum class CollapseRefusal : std::uint8_t {
+  NonManifoldEdge,    ///< an output edge with > 2 faces whose input edges all had <= 2
+  NonManifoldVertex,  ///< an output vertex whose fan splits, no member was non-manifold
+  NewBoundary,        ///< an output edge with 1 face whose input edges all had >= 2
+  DuplicateFace,      ///< two output faces on the same vertex set (not input duplicates)
+  DegenerateFace,     ///< an output face with zero area
+  Flip,               ///< an output face turned more than flip_angle_deg from its input face
+  FoldedCorner,       ///< a convex polygon corner became reflex
+  Hausdorff,          ///< the placed vertex left the max_hausdorff band around the input
+};
+inline constexpr std::size_t kNumCollapseRefusals = 8;
+const char* to_string(CollapseRefusal reason);
+
+enum class ClusterCollapseStatus : std::uint8_t {
+  Ok,
+  InvalidInput,  ///< connectivity or edge_kept does not match the mesh (see `error`)
+};
+
+struct ClusterCollapseStats {
+  Index collapsed_edges_in = 0;     ///< edges the selection marked collapsed
+  Index collapsed_edges_final = 0;  ///< edges whose endpoints ended in one output vertex
+  Index implied_collapsed_edges = 0;  ///< of those, edges the selection marked kept
+  Index clusters = 0;               ///< output vertices made of > 1 input vertex
+  Index clustered_vertices = 0;     ///< input vertices in those clusters
+  Index largest_cluster = 0;        ///< most input vertices in one output vertex
+  Index faces_in = 0;
+  Index faces_out = 0;
+  Index quads_out = 0;
+  Index triangles_out = 0;
+  Index ngons_out = 0;
+  std::uint64_t tri_equivalent_in = 0;
+  std::uint64_t tri_equivalent_out = 0;
+  /// What the selection asked for: tri-equivalents after applying every collapse unchecked.
+  std::uint64_t tri_equivalent_wanted = 0;
+  Index faces_dropped = 0;         ///< input faces left with < 3 distinct corners (removed)
+  Index faces_pinched = 0;         ///< input faces cut at a repeated vertex into simple loops
+  Index quads_to_triangles = 0;    ///< input quads that became one triangle
+  Index vertices_removed_unused = 0;  ///< input vertices no output face uses (besides merging)
+  // Placement.
+  Index placements_volume_constrained = 0;  ///< clusters placed under the volume constraint
+  Index placements_pseudo_inverse = 0;      ///< ill-conditioned systems solved by eigen cutoff
+  Index placements_fallback = 0;            ///< minimiser untrusted: best of centroid/members
+  // Refinement.
+  Index rounds = 0;                ///< check rounds run (1 when nothing was refused)
+  Index clusters_bisected = 0;
+  Index clusters_dissolved = 0;
+  Index edges_restored = 0;        ///< collapsed edges turned back to kept by refusals
+  /// Refusals by reason (each split or dissolve of one cluster counts once).
+  std::array<Index, kNumCollapseRefusals> refused{};
+  /// Tri-equivalents those refusals kept that the selection wanted removed (sums to
+  /// tri_equivalent_out - tri_equivalent_wanted).
+  std::array<std::int64_t, kNumCollapseRefusals> refused_tri_equivalents{};
+
+  Index refusals(CollapseRefusal r) const { return refused[static_cast<std::size_t>(r)]; }
+  Index total_refusals() const;
+};
+
+struct ClusterCollapseResult {
+  ClusterCollapseStatus status = ClusterCollapseStatus::Ok;
+  std::string error;  ///< why the input was rejected (status InvalidInput)
+  /// The reduced mesh: positions of untouched vertices unchanged, uv/normal pools and name
+  /// tables copied whole, each surviving corner keeps its own uv/normal index, faces keep their
+  /// tags and the order of the input faces they come from. Vertex ids are compacted in the order
+  /// of the smallest input vertex of each output vertex.
+  PolyMesh mesh;
+  /// Input vertex → output vertex, or kInvalidIndex for input vertices no output face uses.
+  std::vector<Index> vertex_map;
+  /// One per input (Connectivity) edge: 1 when its endpoints ended in the same output vertex
+  /// (collapsed), 0 when the edge survives. Note the inversion w.r.t. the `edge_kept` input.
+  std::vector<std::uint8_t> edge_collapsed_final;
+  ClusterCollapseStats stats;
+  double seconds = 0.0;
+};
+
+/// Collapses the clusters of `edge_kept` (one entry per `conn` edge: nonzero = kept,
+/// 0 = collapsed) and returns the reduced mesh with the guarantees listed at the top of this file.
+/// Preconditions: `conn` was built from `mesh`. A size mismatch gives status InvalidInput and a
+/// copy of the input mesh (identity vertex_map, nothing collapsed).
+/// Faces the collapse does not touch are passed through; degenerate input faces are not repaired
+/// (only repeated corners are normalised: runs merged, pinched faces cut into loops).
+ClusterCollapseResult collapse_clusters(const PolyMesh& mesh, const Connectivity& conn,
+                                        const std::vector<std::uint8_t>& edge_kept,
+                                        const ClusterCollapseParams& params = {});
+
+/// The stats as a JSON object (for `--report`).
+nlohmann::json to_json(const ClusterCollapseStats& stats);
+
+}  // namespace quadlod

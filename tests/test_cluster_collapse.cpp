@@ -1,0 +1,498 @@
+// Tests of src/post/cluster_collapse.h (paper §3.3.2): hand-built selections with known answers
+// (identity, one grid column, one edge, a cube ring, a flip, a boundary, a crease, the singular
+// quadric), then the guarantees as invariants over random selections on the generated meshes.
+#include "post/cluster_collapse.h"
+
+#include "mesh/connectivity.h"
+#include "mesh/validation.h"
+#include "quadlod/generators.h"
+#include "quadlod/mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace quadlod {
+namespace {
+
+Index edge_between(const Connectivity& conn, Index a, Index b) {
+  for (Index c : conn.corners_at_vertex(a))
+    for (Index ec : {c, conn.corner_prev[c]}) {
+      const Index e = conn.corner_edge[ec];
+      if (conn.other_vertex(e, a) == b) return e;
+    }
+  return kInvalidIndex;
+}
+
+// One entry per edge, all kept, then the listed vertex pairs collapsed.
+std::vector<std::uint8_t> select(const Connectivity& conn,
+                                 const std::vector<std::pair<Index, Index>>& collapse) {
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  for (const auto& [a, b] : collapse) {
+    const Index e = edge_between(conn, a, b);
+    EXPECT_NE(e, kInvalidIndex) << a << "-" << b;
+    if (e != kInvalidIndex) kept[e] = 0;
+  }
+  return kept;
+}
+
+double signed_volume(const PolyMesh& m) {
+  double v = 0.0;
+  for (Index f = 0; f < m.num_faces(); ++f) {
+    const auto vs = m.face_vertices(f);
+    for (std::size_t i = 1; i + 1 < vs.size(); ++i)
+      v += m.positions[vs[0]].dot(m.positions[vs[i]].cross(m.positions[vs[i + 1]])) / 6.0;
+  }
+  return v;
+}
+
+// The output checks every result must pass, relative to its input.
+void expect_valid_output(const PolyMesh& in, const ClusterCollapseResult& r) {
+  ASSERT_EQ(r.status, ClusterCollapseStatus::Ok) << r.error;
+  ASSERT_EQ(r.mesh.check_layout(), "");
+  const Connectivity cin = build_connectivity(in);
+  const Connectivity cout = build_connectivity(r.mesh);
+  const MeshStats sin = compute_stats(in, cin);
+  const MeshStats sout = compute_stats(r.mesh, cout);
+  EXPECT_EQ(sout.degenerate_faces, 0u);
+  EXPECT_EQ(sout.repeated_index_faces, 0u);
+  EXPECT_EQ(sout.duplicate_faces, 0u);
+  EXPECT_EQ(sout.unused_vertices, 0u);
+  EXPECT_EQ(sout.nonfinite_vertices, 0u);
+  EXPECT_LE(sout.nonmanifold_edges, sin.nonmanifold_edges);
+  EXPECT_LE(sout.nonmanifold_vertices, sin.nonmanifold_vertices);
+  EXPECT_LE(sout.boundary_edges, sin.boundary_edges);
+  EXPECT_EQ(r.stats.faces_out, r.mesh.num_faces());
+  EXPECT_EQ(r.stats.tri_equivalent_out, tri_equivalent_count(r.mesh));
+  EXPECT_EQ(r.stats.quads_out, sout.quads);
+  EXPECT_EQ(r.stats.triangles_out, sout.triangles);
+  // Refusals account for every tri-equivalent kept beyond what the selection asked for.
+  std::int64_t kept = 0;
+  for (auto k : r.stats.refused_tri_equivalents) kept += k;
+  EXPECT_EQ(std::int64_t(r.stats.tri_equivalent_out) - std::int64_t(r.stats.tri_equivalent_wanted), kept);
+  // vertex_map and edge_collapsed_final agree with each other.
+  ASSERT_EQ(r.vertex_map.size(), in.num_vertices());
+  ASSERT_EQ(r.edge_collapsed_final.size(), cin.num_edges);
+  for (Index e = 0; e < cin.num_edges; ++e) {
+    const auto [a, b] = cin.edge_vertices[e];
+    if (a == b || r.vertex_map[a] == kInvalidIndex) continue;
+    EXPECT_EQ(r.edge_collapsed_final[e] != 0, r.vertex_map[a] == r.vertex_map[b]) << "edge " << e;
+  }
+  // Each surviving corner keeps a UV of one of the input corners at a vertex that maps to it
+  // (generators give corner_uv[c] == some lattice index; here only: indices stay in the pool).
+  ASSERT_EQ(r.mesh.uvs.size(), in.uvs.size());
+}
+
+// --- known answers -------------------------------------------------------------------------------
+
+TEST(ClusterCollapse, NothingCollapsedIsIdentity) {
+  PolyMesh in = make_demo_vase(12, 5);
+  in.material_names = {"glaze", "clay"};
+  in.face_material.assign(in.num_faces(), 0);
+  in.face_material[3] = 1;
+  const Connectivity conn = build_connectivity(in);
+  const std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.mesh.positions, in.positions);
+  EXPECT_EQ(r.mesh.face_offsets, in.face_offsets);
+  EXPECT_EQ(r.mesh.corner_vertex, in.corner_vertex);
+  EXPECT_EQ(r.mesh.corner_uv, in.corner_uv);
+  EXPECT_EQ(r.mesh.uvs, in.uvs);
+  EXPECT_EQ(r.mesh.face_material, in.face_material);
+  EXPECT_EQ(r.mesh.material_names, in.material_names);
+  for (Index v = 0; v < in.num_vertices(); ++v) EXPECT_EQ(r.vertex_map[v], v);
+  EXPECT_EQ(r.stats.clusters, 0u);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  EXPECT_EQ(r.stats.rounds, 1u);
+  for (auto c : r.edge_collapsed_final) EXPECT_EQ(c, 0);
+}
+
+TEST(ClusterCollapse, UnusedInputVerticesAreRemoved) {
+  PolyMesh in = make_grid(2, 2);
+  in.add_vertex(Vec3(5, 5, 5));  // used by no face
+  const Connectivity conn = build_connectivity(in);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, std::vector<std::uint8_t>(conn.num_edges, 1));
+  EXPECT_EQ(r.mesh.num_vertices(), 9u);
+  EXPECT_EQ(r.vertex_map[9], kInvalidIndex);
+  EXPECT_EQ(r.stats.vertices_removed_unused, 1u);
+  EXPECT_EQ(r.mesh.corner_vertex, in.corner_vertex);
+}
+
+// make_grid(6, 4): vertex id(i, j) = j·7 + i at (i/6, j/4). The chord of column 2 (quads (2, j))
+// crosses the horizontal edges id(2,j)–id(3,j), j = 0..4: collapsing them merges the vertical
+// lines x = 2/6 and x = 3/6, removing one column of quads.
+TEST(ClusterCollapse, GridColumnChordRemovesOneColumn) {
+  const Index n = 6, m = 4;
+  const PolyMesh in = make_grid(n, m);
+  const Connectivity conn = build_connectivity(in);
+  auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.mesh.num_faces(), (n - 1) * m);
+  EXPECT_EQ(r.stats.quads_out, (n - 1) * m);
+  EXPECT_EQ(r.stats.triangles_out, 0u);
+  EXPECT_EQ(r.mesh.num_vertices(), in.num_vertices() - (m + 1));
+  EXPECT_EQ(r.stats.clusters, m + 1);
+  EXPECT_EQ(r.stats.faces_dropped, m);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  EXPECT_EQ(r.stats.tri_equivalent_out, 2u * (n - 1) * m);
+  for (Index j = 0; j <= m; ++j) {
+    const Index a = r.vertex_map[id(2, j)];
+    ASSERT_EQ(a, r.vertex_map[id(3, j)]);
+    const Vec3& p = r.mesh.positions[a];
+    EXPECT_NEAR(p.z(), 0.0, 1e-12);
+    EXPECT_NEAR(p.y(), double(j) / m, 1e-12);  // boundary rows stay on the boundary
+    EXPECT_GE(p.x(), 2.0 / 6 - 1e-12);
+    EXPECT_LE(p.x(), 3.0 / 6 + 1e-12);
+    EXPECT_NEAR(p.x(), 2.5 / 6, 1e-9);  // symmetric: the middle
+  }
+  // Surviving corners keep their own UV (grid: uv index == input vertex id).
+  for (Index c = 0; c < r.mesh.num_corners(); ++c)
+    EXPECT_EQ(r.vertex_map[r.mesh.corner_uv[c]], r.mesh.corner_vertex[c]);
+}
+
+TEST(ClusterCollapse, SingleEdgeBetweenTwoQuadsMakesTwoTriangles) {
+  PolyMesh in = make_grid(6, 4);
+  in.group_names = {"g0", "g1"};
+  in.face_group.resize(in.num_faces());
+  for (Index f = 0; f < in.num_faces(); ++f) in.face_group[f] = f % 2;
+  const Connectivity conn = build_connectivity(in);
+  auto id = [](Index i, Index j) { return j * 7 + i; };
+  // The vertical edge x = 3/6, y in [1/4, 2/4] is shared by quads (2, 1) and (3, 1).
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, {{id(3, 1), id(3, 2)}}));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.triangles_out, 2u);
+  EXPECT_EQ(r.stats.quads_out, 22u);
+  EXPECT_EQ(r.stats.quads_to_triangles, 2u);
+  EXPECT_EQ(r.stats.tri_equivalent_in - r.stats.tri_equivalent_out, 2u);
+  EXPECT_EQ(r.mesh.num_vertices(), in.num_vertices() - 1);
+  // Faces keep their input order and tags (no face was dropped).
+  ASSERT_EQ(r.mesh.num_faces(), in.num_faces());
+  EXPECT_EQ(r.mesh.face_group, in.face_group);
+  EXPECT_EQ(r.mesh.face_size(1 * 6 + 2), 3u);
+  EXPECT_EQ(r.mesh.face_size(1 * 6 + 3), 3u);
+  const Vec3& p = r.mesh.positions[r.vertex_map[id(3, 1)]];
+  EXPECT_NEAR(p.x(), 0.5, 1e-9);
+  EXPECT_NEAR(p.y(), 0.375, 1e-9);
+  EXPECT_NEAR(p.z(), 0.0, 1e-12);
+}
+
+// make_cube(3): vertices at ±1/2, ±1/6. The closed chord of the middle band around Z crosses the
+// 12 edges that run from z = −1/6 to z = +1/6. Collapsing them leaves a 1 × 1 × 2/3 box.
+TEST(ClusterCollapse, CubeClosedChordStaysClosedManifold) {
+  const PolyMesh in = make_cube(3);
+  const Connectivity conn = build_connectivity(in);
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  Index chord_edges = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const Vec3& a = in.positions[conn.edge_vertices[e][0]];
+    const Vec3& b = in.positions[conn.edge_vertices[e][1]];
+    if (std::abs(std::abs(a.z()) - 1.0 / 6) < 1e-9 && std::abs(std::abs(b.z()) - 1.0 / 6) < 1e-9 &&
+        std::abs(a.z() - b.z()) > 0.1) {
+      kept[e] = 0;
+      ++chord_edges;
+    }
+  }
+  ASSERT_EQ(chord_edges, 12u);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  const Connectivity co = build_connectivity(r.mesh);
+  const MeshStats s = compute_stats(r.mesh, co);
+  EXPECT_EQ(s.boundary_edges, 0u);
+  EXPECT_EQ(s.nonmanifold_edges, 0u);
+  EXPECT_EQ(s.nonmanifold_vertices, 0u);
+  EXPECT_EQ(s.components, 1u);
+  EXPECT_EQ(s.quads, 54u - 12u);
+  const long euler = long(r.mesh.num_vertices()) - long(co.num_edges) + long(r.mesh.num_faces());
+  EXPECT_EQ(euler, 2);
+  const double volume = signed_volume(r.mesh);
+  EXPECT_GT(volume, 0.0);
+  // The band's vertices land on z = 0 and the sides stay planar: the shape (and the volume) of
+  // the unit cube is unchanged, only its middle row of quads is gone.
+  EXPECT_NEAR(volume, 1.0, 1e-9);
+  for (Index v = 0; v < r.mesh.num_vertices(); ++v) {
+    const Vec3& p = r.mesh.positions[v];
+    EXPECT_NEAR(p.cwiseAbs().maxCoeff(), 0.5, 1e-12);  // every vertex on the cube's surface
+    // z levels −1/2, −1/6, 1/6, 1/2 become −1/2, 0, 1/2.
+    EXPECT_TRUE(std::abs(p.z()) < 1e-12 || std::abs(std::abs(p.z()) - 0.5) < 1e-12) << p.transpose();
+  }
+}
+
+// A flat disk around the edge a–b: a thin triangle T = (a, s, t) whose edge s–t, extended, crosses
+// the x axis at x ≈ 0.27. Any merged position past that line (the quadric places it well inside
+// the disk, x ≈ 0.7) turns T over, so the collapse is refused under "flip".
+TEST(ClusterCollapse, CollapseThatFlipsAFaceIsRefused) {
+  PolyMesh in;
+  const Index a = in.add_vertex({0, 0, 0}), b = in.add_vertex({2, 0, 0});
+  const Index s = in.add_vertex({0.1, 0.3, 0}), t = in.add_vertex({-0.3, 1.0, 0});
+  const Index w = in.add_vertex({-1, -0.2, 0}), l = in.add_vertex({1, -1.2, 0});
+  const Index q = in.add_vertex({3, 0, 0});
+  in.add_face({a, b, s});
+  in.add_face({a, s, t});
+  in.add_face({a, t, w});
+  in.add_face({a, w, l});
+  in.add_face({a, l, b});
+  in.add_face({b, q, s});
+  in.add_face({b, l, q});
+  const Connectivity conn = build_connectivity(in);
+  ASSERT_EQ(compute_stats(in, conn).degenerate_faces, 0u);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, {{a, b}}));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.refusals(CollapseRefusal::Flip), 1u);
+  EXPECT_EQ(r.stats.total_refusals(), 1u);
+  EXPECT_EQ(r.stats.refused_tri_equivalents[std::size_t(CollapseRefusal::Flip)], 2);
+  EXPECT_EQ(r.stats.tri_equivalent_wanted, 5u);
+  EXPECT_EQ(r.stats.edges_restored, 1u);
+  EXPECT_EQ(r.edge_collapsed_final[edge_between(conn, a, b)], 0);
+  EXPECT_EQ(r.mesh.corner_vertex, in.corner_vertex);
+  EXPECT_EQ(r.mesh.positions, in.positions);
+  EXPECT_EQ(r.stats.rounds, 2u);
+
+  // Without the refusal the merged vertex would really have turned T over.
+  ClusterCollapseParams lax;
+  lax.flip_angle_deg = 180.0;
+  const ClusterCollapseResult bad = collapse_clusters(in, conn, select(conn, {{a, b}}), lax);
+  ASSERT_EQ(bad.mesh.num_faces(), 5u);
+  EXPECT_LT(face_area_vector(bad.mesh, 0).z(), 0.0);  // (x, s, t) now faces down
+}
+
+// An open grid bent upward (z = 0.3 y²): collapsing a boundary edge keeps the merged vertex on the
+// straight boundary line y = 0, z = 0 (boundary constraint planes, consistent face planes).
+TEST(ClusterCollapse, BoundaryEdgeCollapseKeepsBoundaryStraight) {
+  PolyMesh in = make_grid(6, 4);
+  for (Vec3& p : in.positions) p.z() = 0.3 * p.y() * p.y();
+  const Connectivity conn = build_connectivity(in);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, {{2, 3}}));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  const Vec3& p = r.mesh.positions[r.vertex_map[2]];
+  EXPECT_NEAR(p.y(), 0.0, 1e-12);
+  EXPECT_NEAR(p.z(), 0.0, 1e-12);
+  EXPECT_NEAR(p.x(), 2.5 / 6, 1e-9);
+  const MeshStats s = compute_stats(r.mesh, build_connectivity(r.mesh));
+  EXPECT_EQ(s.boundary_edges, 2u * (6 + 4) - 1);
+}
+
+// A grid folded 90° along x = 1/2 (the right half turned up into the plane x = 1/2).
+PolyMesh folded_grid() {
+  PolyMesh in = make_grid(4, 4);
+  for (Vec3& p : in.positions)
+    if (p.x() > 0.5) p = Vec3(0.5, p.y(), p.x() - 0.5);
+  return in;
+}
+
+TEST(ClusterCollapse, CreaseVerticesStayOnTheCrease) {
+  const PolyMesh in = folded_grid();
+  const Connectivity conn = build_connectivity(in);
+  auto id = [](Index i, Index j) { return j * 5 + i; };
+  // An edge along the crease.
+  {
+    const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, {{id(2, 1), id(2, 2)}}));
+    expect_valid_output(in, r);
+    EXPECT_EQ(r.stats.total_refusals(), 0u);
+    const Vec3& p = r.mesh.positions[r.vertex_map[id(2, 1)]];
+    EXPECT_NEAR(p.x(), 0.5, 1e-12);
+    EXPECT_NEAR(p.z(), 0.0, 1e-12);
+    EXPECT_NEAR(p.y(), 0.375, 1e-9);
+  }
+  // The chord of the column left of the crease: the crease vertices pull the merged vertices onto
+  // the crease (face planes of both sides, sharp-edge planes), not half-way into the flat side.
+  // Not exactly: Knodt's tangential edge planes of the flat vertex (weight 0.01) pull toward its
+  // old line x = 1/4, and the volume constraint trades that for a dip in z. Both stay within 1% of
+  // the edge length h = 1/4.
+  {
+    std::vector<std::pair<Index, Index>> chord;
+    for (Index j = 0; j <= 4; ++j) chord.emplace_back(id(1, j), id(2, j));
+    const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
+    expect_valid_output(in, r);
+    EXPECT_EQ(r.stats.total_refusals(), 0u);
+    for (Index j = 0; j <= 4; ++j) {
+      const Vec3& p = r.mesh.positions[r.vertex_map[id(2, j)]];
+      EXPECT_NEAR(p.x(), 0.5, 0.01 * 0.25) << j;
+      EXPECT_NEAR(p.z(), 0.0, 0.01 * 0.25) << j;
+      EXPECT_LE(p.x(), 0.5);
+      EXPECT_NEAR(p.y(), j / 4.0, 1e-9) << j;
+    }
+  }
+}
+
+// A flat 3×3 block of vertices merged into one. With every term that makes the system regular
+// turned off, the quadric is rank one (only the plane z = 0): the pseudo-inverse around the
+// centroid must still give a finite point inside the block.
+TEST(ClusterCollapse, SingularQuadricOnFlatGridGivesFinitePositionInsideCluster) {
+  const PolyMesh in = make_grid(6, 6);
+  const Connectivity conn = build_connectivity(in);
+  auto id = [](Index i, Index j) { return j * 7 + i; };
+  std::vector<std::pair<Index, Index>> block;
+  for (Index j = 2; j <= 4; ++j)
+    for (Index i = 2; i <= 4; ++i) {
+      if (i < 4) block.emplace_back(id(i, j), id(i + 1, j));
+      if (j < 4) block.emplace_back(id(i, j), id(i, j + 1));
+    }
+  for (bool regular : {true, false}) {
+    ClusterCollapseParams params;
+    if (!regular) {
+      params.regularization = 0.0;
+      params.edge_plane_weight = 0.0;
+    }
+    const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, block), params);
+    expect_valid_output(in, r);
+    EXPECT_EQ(r.stats.clusters, 1u);
+    EXPECT_EQ(r.stats.largest_cluster, 9u);
+    EXPECT_EQ(r.stats.placements_pseudo_inverse, regular ? 0u : 1u);
+    const Vec3& p = r.mesh.positions[r.vertex_map[id(3, 3)]];
+    ASSERT_TRUE(p.allFinite());
+    EXPECT_GE(p.x(), 2.0 / 6 - 1e-12);
+    EXPECT_LE(p.x(), 4.0 / 6 + 1e-12);
+    EXPECT_GE(p.y(), 2.0 / 6 - 1e-12);
+    EXPECT_LE(p.y(), 4.0 / 6 + 1e-12);
+    EXPECT_NEAR(p.z(), 0.0, 1e-12);
+    EXPECT_NEAR(p.x(), 0.5, 1e-9);  // symmetric block
+    EXPECT_NEAR(p.y(), 0.5, 1e-9);
+  }
+}
+
+// The bare Garland–Heckbert quadric (no edge planes, no regulariser, no cutoff, no volume
+// constraint) of a bumpy grid has minimisers far outside some clusters: those fall back to the
+// best of centroid / members. With the default terms nothing needs the fallback. Either way every
+// merged vertex stays inside its members' box grown by the margin.
+TEST(ClusterCollapse, UntrustedMinimiserFallsBackInsideTheCluster) {
+  PolyMesh in = make_grid(12, 12);
+  std::mt19937_64 g(7);
+  for (Vec3& p : in.positions) p.z() = 0.01 * double(g() % 1000) / 1000.0;
+  const Connectivity conn = build_connectivity(in);
+  std::mt19937_64 h(11);
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  for (auto& k : kept) k = (double(h() >> 11) * 0x1.0p-53) < 0.2 ? 0 : 1;
+  ClusterCollapseParams bare;
+  bare.regularization = 0.0;
+  bare.edge_plane_weight = 0.0;
+  bare.eigen_cutoff = 0.0;
+  bare.preserve_volume = false;
+  const double mean_edge = 1.0 / 12;
+  for (bool use_bare : {true, false}) {
+    const ClusterCollapseParams params = use_bare ? bare : ClusterCollapseParams{};
+    const ClusterCollapseResult r = collapse_clusters(in, conn, kept, params);
+    expect_valid_output(in, r);
+    if (use_bare) EXPECT_GT(r.stats.placements_fallback, 0u);
+    else EXPECT_EQ(r.stats.placements_fallback, 0u);
+    EXPECT_GT(r.stats.clusters, 10u);
+    std::vector<BoundingBox> boxes(r.mesh.num_vertices());
+    for (Index v = 0; v < in.num_vertices(); ++v)
+      if (r.vertex_map[v] != kInvalidIndex) boxes[r.vertex_map[v]].extend(in.positions[v]);
+    for (Index o = 0; o < r.mesh.num_vertices(); ++o) {
+      const double margin = params.bbox_margin * std::max(boxes[o].diagonal(), mean_edge) * 1.01;
+      const Vec3& p = r.mesh.positions[o];
+      EXPECT_TRUE((p.array() >= boxes[o].min.array() - margin).all() &&
+                  (p.array() <= boxes[o].max.array() + margin).all())
+          << "vertex " << o << " at " << p.transpose();
+    }
+  }
+}
+
+TEST(ClusterCollapse, HausdorffBoundRefusesFarPlacements) {
+  const PolyMesh in = make_torus(12, 8);
+  const Connectivity conn = build_connectivity(in);
+  // Collapse the ring of edges i = 0 → 1 around the tube (a closed chord of the torus).
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j < 8; ++j) chord.emplace_back(0 * 8 + j, 1 * 8 + j);
+  const auto kept = select(conn, chord);
+  ClusterCollapseParams strict;
+  strict.max_hausdorff = 1e-6;
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept, strict);
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.refusals(CollapseRefusal::Hausdorff), 8u);
+  EXPECT_EQ(r.stats.clusters, 0u);
+  const ClusterCollapseResult loose = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, loose);
+  EXPECT_EQ(loose.stats.total_refusals(), 0u);
+  EXPECT_EQ(loose.stats.clusters, 8u);
+  EXPECT_EQ(loose.mesh.num_faces(), 11u * 8u);
+}
+
+TEST(ClusterCollapse, MismatchedSelectionIsInvalidInput) {
+  const PolyMesh in = make_grid(2, 2);
+  const Connectivity conn = build_connectivity(in);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, std::vector<std::uint8_t>(3, 0));
+  EXPECT_EQ(r.status, ClusterCollapseStatus::InvalidInput);
+  EXPECT_FALSE(r.error.empty());
+  EXPECT_EQ(r.mesh.corner_vertex, in.corner_vertex);
+}
+
+// --- invariants over random selections -----------------------------------------------------------
+
+struct NamedMesh {
+  const char* name;
+  PolyMesh mesh;
+};
+
+std::vector<NamedMesh> invariant_meshes() {
+  std::vector<NamedMesh> ms;
+  ms.push_back({"vase", make_demo_vase(16, 10)});
+  ms.push_back({"torus", make_torus(12, 8)});
+  ms.push_back({"cube", make_cube(4)});
+  ms.push_back({"cylinder", make_cylinder(10, 5)});
+  ms.push_back({"grid", make_grid(9, 7)});
+  PolyMesh bumpy = make_grid(10, 10);
+  std::mt19937_64 g(7);
+  for (Vec3& p : bumpy.positions) p.z() = 0.05 * double(g() % 1000) / 1000.0;
+  ms.push_back({"bumpy", std::move(bumpy)});
+  return ms;
+}
+
+TEST(ClusterCollapseInvariants, RandomSelectionsGiveValidMeshes) {
+  for (const NamedMesh& nm : invariant_meshes()) {
+    const Connectivity conn = build_connectivity(nm.mesh);
+    for (double fraction : {0.05, 0.2, 0.5}) {
+      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        SCOPED_TRACE(std::string(nm.name) + " fraction " + std::to_string(fraction) + " seed " +
+                     std::to_string(seed));
+        std::mt19937_64 g(seed * 977 + static_cast<std::uint64_t>(fraction * 100));
+        std::vector<std::uint8_t> kept(conn.num_edges, 1);
+        for (auto& k : kept) k = (double(g() >> 11) * 0x1.0p-53) < fraction ? 0 : 1;
+        for (Index rounds : {Index{8}, Index{0}}) {
+          ClusterCollapseParams params;
+          params.max_bisect_rounds = rounds;
+          const ClusterCollapseResult r = collapse_clusters(nm.mesh, conn, kept, params);
+          expect_valid_output(nm.mesh, r);
+          EXPECT_LE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_in);
+          EXPECT_GE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_wanted);
+          if (seed == 1) {  // deterministic
+            const ClusterCollapseResult again = collapse_clusters(nm.mesh, conn, kept, params);
+            EXPECT_EQ(again.mesh.corner_vertex, r.mesh.corner_vertex);
+            EXPECT_EQ(again.mesh.positions, r.mesh.positions);
+          }
+        }
+      }
+    }
+  }
+}
+
+// Every closed chord-ring collapse on the cube and torus (the pipeline's typical input: whole
+// chords) keeps the surface closed and orientable with positive volume.
+TEST(ClusterCollapseInvariants, ClosedMeshesStayClosed) {
+  for (const NamedMesh& nm : invariant_meshes()) {
+    const Connectivity conn = build_connectivity(nm.mesh);
+    const MeshStats sin = compute_stats(nm.mesh, conn);
+    if (sin.boundary_edges != 0) continue;
+    std::mt19937_64 g(42);
+    std::vector<std::uint8_t> kept(conn.num_edges, 1);
+    for (auto& k : kept) k = g() % 4 == 0 ? 0 : 1;
+    const ClusterCollapseResult r = collapse_clusters(nm.mesh, conn, kept);
+    SCOPED_TRACE(nm.name);
+    expect_valid_output(nm.mesh, r);
+    const MeshStats s = compute_stats(r.mesh, build_connectivity(r.mesh));
+    EXPECT_EQ(s.boundary_edges, 0u);
+    EXPECT_EQ(s.components, sin.components);
+    EXPECT_GT(signed_volume(r.mesh), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace quadlod

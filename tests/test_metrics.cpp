@@ -1,0 +1,532 @@
+// Tests of `quadlod eval` (include/quadlod/metrics.h, docs/metrics.md) and of the deterministic
+// samplers (src/geometry/sampling.h): closed forms, oracles and determinism.
+#include "quadlod/metrics.h"
+
+#include "geometry/bvh.h"
+#include "geometry/sampling.h"
+#include "quadlod/generators.h"
+#include "quadlod/io.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <vector>
+
+namespace quadlod {
+namespace {
+
+// Small sample counts keep the sanitizer build fast; closed-form tolerances below are derived
+// from these counts.
+EvalParams small_params(std::uint64_t samples = 4000, std::uint64_t curve_samples = 4000) {
+  EvalParams p;
+  p.samples = samples;
+  p.curve_samples = curve_samples;
+  return p;
+}
+
+PolyMesh transformed(PolyMesh m, double scale, const Vec3& about, const Vec3& shift = Vec3::Zero()) {
+  for (Vec3& p : m.positions) p = about + scale * (p - about) + shift;
+  return m;
+}
+
+/// Every face fanned from its corner 0 (the same triangles the metrics measure).
+PolyMesh fan_triangulated(const PolyMesh& m) {
+  PolyMesh out;
+  out.positions = m.positions;
+  for (Index f = 0; f < m.num_faces(); ++f) {
+    const auto v = m.face_vertices(f);
+    for (std::size_t i = 1; i + 1 < v.size(); ++i) out.add_face({v[0], v[i], v[i + 1]});
+  }
+  return out;
+}
+
+// --- generators and samplers -------------------------------------------------------------------
+
+TEST(EvalSampling, Splitmix64KnownAnswers) {
+  std::uint64_t s = 0;
+  EXPECT_EQ(splitmix64(s), 0xE220A8397B1DCDAFULL);
+  EXPECT_EQ(splitmix64(s), 0x6E789E6AA1B965F4ULL);
+  EXPECT_EQ(splitmix64(s), 0x06C45D188009454FULL);
+}
+
+TEST(EvalSampling, Xoshiro256KnownAnswers) {
+  // Reference output of xoshiro256** 1.0 for state {1, 2, 3, 4}.
+  Xoshiro256 g = Xoshiro256::from_state({1, 2, 3, 4});
+  EXPECT_EQ(g.next(), 11520ULL);
+  EXPECT_EQ(g.next(), 0ULL);
+  EXPECT_EQ(g.next(), 1509978240ULL);
+  EXPECT_EQ(g.next(), 1215971899390074240ULL);
+  // Seeding through splitmix64 (values from an independent Python implementation).
+  Xoshiro256 a(1, 0), b(1, 1), c(42, 0);
+  EXPECT_EQ(a.next(), 0xB3F2AF6D0FC710C5ULL);
+  EXPECT_EQ(b.next(), 0xBAA24E21D05C2935ULL);
+  EXPECT_EQ(c.next(), 0x15780B2E0C2EC716ULL);
+  EXPECT_EQ(a.uniform01(), 0.5204366199388569);
+  EXPECT_EQ(b.uniform01(), 0.10028392203766334);
+}
+
+TEST(EvalSampling, SurfaceSamplesLieOnTheirTrianglesAndFollowArea) {
+  PolyMesh m = make_demo_vase(16, 10);
+  // A zero-area face (collinear corners) must never receive a sample.
+  const Index a = m.add_vertex({5, 5, 5}), b = m.add_vertex({6, 5, 5}), c = m.add_vertex({7, 5, 5});
+  m.add_face({a, b, c});
+  const TriangleSoup soup = fan_triangulate(m);
+  const std::uint64_t n = 50000;
+  const SurfaceSamples s = sample_triangles(soup, n, 3, 0);
+  ASSERT_EQ(s.points.size(), n);
+  std::vector<double> hits(soup.triangles.size(), 0.0);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const auto& t = soup.triangles[s.triangle[k]];
+    EXPECT_LE((closest_point_on_triangle(s.points[k], t[0], t[1], t[2]).point - s.points[k]).norm(), 1e-14);
+    hits[s.triangle[k]] += 1;
+  }
+  EXPECT_EQ(hits.back(), 0.0);
+  // Per-face counts follow the area share: binomial, |count − n·p| <= 5·sqrt(n·p(1−p)) + 1.
+  double total = 0;
+  for (const auto& t : soup.triangles) total += triangle_area(t);
+  EXPECT_DOUBLE_EQ(total, s.total_area);
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+    const double p = triangle_area(soup.triangles[t]) / total;
+    EXPECT_LE(std::abs(hits[t] - n * p), 5 * std::sqrt(n * p * (1 - p)) + 1) << "triangle " << t;
+  }
+}
+
+TEST(EvalSampling, SameSeedSameSamplesOtherSeedOrStreamOthers) {
+  const TriangleSoup soup = fan_triangulate(make_torus(12, 8));
+  const SurfaceSamples a = sample_triangles(soup, 1000, 5, 0);
+  const SurfaceSamples b = sample_triangles(soup, 1000, 5, 0);
+  const SurfaceSamples c = sample_triangles(soup, 1000, 6, 0);
+  const SurfaceSamples d = sample_triangles(soup, 1000, 5, 1);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.triangle, b.triangle);
+  int same_c = 0, same_d = 0;
+  for (int k = 0; k < 1000; ++k) {
+    same_c += a.points[k] == c.points[k];
+    same_d += a.points[k] == d.points[k];
+  }
+  EXPECT_EQ(same_c, 0);
+  EXPECT_EQ(same_d, 0);
+}
+
+TEST(EvalSampling, ArcLengthSamplesAreEvenlySpaced) {
+  // Segments of lengths 1, 0, 3 along the x axis, concatenated: L = 4, 8 samples at 0.25 + k/2.
+  const std::vector<std::array<Vec3, 2>> segs = {
+      {Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(1, 0, 0), Vec3(1, 0, 0)}, {Vec3(1, 0, 0), Vec3(4, 0, 0)}};
+  const CurveSamples s = sample_segments_by_arc_length(segs, 8);
+  EXPECT_EQ(s.total_length, 4.0);
+  ASSERT_EQ(s.points.size(), 8u);
+  for (int k = 0; k < 8; ++k) EXPECT_NEAR(s.points[k].x(), 0.25 + 0.5 * k, 1e-15) << k;
+  EXPECT_TRUE(sample_segments_by_arc_length({}, 8).points.empty());
+  const std::vector<std::array<Vec3, 2>> zero = {{Vec3(1, 2, 3), Vec3(1, 2, 3)}};
+  EXPECT_TRUE(sample_segments_by_arc_length(zero, 8).points.empty());
+}
+
+// --- QPR ---------------------------------------------------------------------------------------------
+
+FaceCounts counts(std::uint64_t quads, std::uint64_t tris, std::uint64_t ngons = 0) {
+  FaceCounts c;
+  c.quads = quads;
+  c.tris = tris;
+  c.ngons = ngons;
+  c.faces = quads + tris + ngons;
+  return c;
+}
+
+TEST(EvalMetrics, QprRuleTable) {
+  std::string rule;
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 20), counts(40, 10), &rule), (40.0 * 20) / (10 * 100.0));
+  EXPECT_EQ(rule, "ratio");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 20), counts(100, 20), &rule), 1.0);
+  EXPECT_EQ(rule, "ratio");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 20), counts(0, 250), &rule), 0.0);
+  EXPECT_EQ(rule, "no_output_quads");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 0), counts(0, 200), &rule), 0.0);
+  EXPECT_EQ(rule, "no_output_quads");
+  EXPECT_EQ(quad_preservation_ratio(counts(0, 50), counts(0, 20), &rule), 1.0);
+  EXPECT_EQ(rule, "no_input_quads");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 0), counts(30, 10), &rule), 30.0 / 40.0);
+  EXPECT_EQ(rule, "input_tri_free");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 0), counts(30, 0, 5), &rule), 1.0);
+  EXPECT_EQ(rule, "input_tri_free");
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 20), counts(30, 0), &rule), 2.0 * 30 * 20 / 100);
+  EXPECT_EQ(rule, "output_tri_free");
+  // N-gons do not enter QPR.
+  EXPECT_EQ(quad_preservation_ratio(counts(100, 20, 7), counts(40, 10, 99)),
+            quad_preservation_ratio(counts(100, 20), counts(40, 10)));
+}
+
+TEST(EvalMetrics, QprIsFiniteAndMonotoneInOutputCounts) {
+  for (const FaceCounts& in : {counts(0, 0, 3), counts(0, 10), counts(10, 0), counts(10, 10),
+                               counts(500, 3), counts(1, 900)}) {
+    for (std::uint64_t qo = 0; qo <= 30; ++qo)
+      for (std::uint64_t to = 0; to <= 30; ++to) {
+        const double v = quad_preservation_ratio(in, counts(qo, to));
+        ASSERT_TRUE(std::isfinite(v));
+        ASSERT_GE(v, 0.0);
+        // More output quads never lowers QPR; more output triangles never raises it.
+        ASSERT_LE(v, quad_preservation_ratio(in, counts(qo + 1, to))) << qo << " " << to;
+        ASSERT_GE(v, quad_preservation_ratio(in, counts(qo, to + 1))) << qo << " " << to;
+      }
+    // Against itself: 1.
+    EXPECT_EQ(quad_preservation_ratio(in, in), 1.0);
+  }
+}
+
+// --- whole-evaluation closed forms ----------------------------------------------------------------
+
+void expect_self_evaluation_is_zero(const PolyMesh& m, const char* what) {
+  const EvalResult r = evaluate(m, m, small_params());
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_LE(r.chamfer, 1e-12) << what;
+  EXPECT_LE(r.chamfer_sq, 1e-24) << what;
+  EXPECT_LE(r.hausdorff, 1e-12) << what;
+  EXPECT_EQ(r.qpr, 1.0) << what;
+  EXPECT_TRUE(r.pccd_defined) << what;
+  EXPECT_LE(r.pccd, 1e-12) << what;
+  EXPECT_EQ(r.chords_in, r.chords_out);
+  EXPECT_EQ(r.quad_fraction_in, r.quad_fraction_out);
+  EXPECT_EQ(r.counts_in.tri_equivalent, tri_equivalent_count(m));
+}
+
+TEST(EvalMetrics, MeshAgainstItselfIsPerfect) {
+  const PolyMesh torus = make_torus(24, 12);
+  expect_self_evaluation_is_zero(torus, "torus");
+  expect_self_evaluation_is_zero(make_demo_vase(16, 10), "vase");
+  expect_self_evaluation_is_zero(make_grid(10, 7), "grid");
+  // An all-quad mesh against itself: every output sample's closest input face is its own quad.
+  const EvalResult r = evaluate(torus, torus, small_params());
+  EXPECT_EQ(r.flow_deviation_deg, 0.0);
+  EXPECT_EQ(r.flow_deviation_p90_deg, 0.0);
+  EXPECT_EQ(r.flow_coverage, 1.0);
+  EXPECT_EQ(r.qpr_rule, "input_tri_free");
+}
+
+// ∫₀¹∫₀¹ sqrt(1 + s² + t²) ds dt: inner integral in closed form, outer by composite Simpson.
+double unit_square_mean_of_sqrt_1_s2_t2() {
+  auto inner = [](double s) {  // ∫₀¹ sqrt(c² + t²) dt, c² = 1 + s²
+    const double c2 = 1 + s * s, c = std::sqrt(c2);
+    return 0.5 * (std::sqrt(c2 + 1) + c2 * std::asinh(1 / c));
+  };
+  const int n = 20000;
+  double sum = inner(0) + inner(1);
+  for (int i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * inner(double(i) / n);
+  return sum / (3.0 * n);
+}
+
+// Unit cube [-½,½]³ against the same cube scaled 1.1 about its centre, h = 0.05:
+//   in → out: every inner point is exactly h from the outer box (it is inside, and the nearest
+//     outer face plane is h away), vertices included: mean = max = h.
+//   out → in: an outer point at (0.55, u, v) is sqrt(h² + f(u)² + f(v)²) from the inner box,
+//     f(t) = max(|t| − ½, 0). Per 1.1 × 1.1 face: area 1 at distance h, area 0.2 (edge strips)
+//     with mean h·K1, area 0.01 (corner squares) with mean h·K2, where
+//     K1 = ∫₀¹ sqrt(1 + t²) dt = ½(√2 + asinh 1),  K2 = ∫₀¹∫₀¹ sqrt(1 + s² + t²).
+//     E[d] = h(1 + 0.2 K1 + 0.01 K2) / 1.21,   E[d²] = h²(1 + 0.2·4/3 + 0.01·5/3) / 1.21.
+//     The maximum is at the outer corners (vertex samples): h√3.
+struct CubeClosedForm {
+  double h = 0.05;
+  double mean_out, mean_sq_out, sd_out, sd_sq_out;
+  CubeClosedForm() {
+    const double k1 = 0.5 * (std::sqrt(2.0) + std::asinh(1.0));
+    const double k2 = unit_square_mean_of_sqrt_1_s2_t2();
+    mean_out = h * (1 + 0.2 * k1 + 0.01 * k2) / 1.21;
+    mean_sq_out = h * h * (1 + 0.2 * 4.0 / 3 + 0.01 * 5.0 / 3) / 1.21;
+    sd_out = std::sqrt(mean_sq_out - mean_out * mean_out);
+    sd_sq_out = h * h;  // d² ∈ [h², 3h²]: sd <= half the range
+  }
+};
+
+void expect_cube_closed_form(const EvalResult& r, std::uint64_t n) {
+  const CubeClosedForm cf;
+  const double h = cf.h;
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_NEAR(r.mean_in_to_out, h, 1e-12);
+  EXPECT_NEAR(r.hausdorff_in_to_out, h, 1e-12);
+  EXPECT_NEAR(r.hausdorff_out_to_in, h * std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(r.hausdorff, h * std::sqrt(3.0), 1e-12);
+  // Deterministic bounds: every out→in distance is in [h, h√3].
+  EXPECT_GE(r.mean_out_to_in, h - 1e-12);
+  EXPECT_LE(r.mean_out_to_in, h * std::sqrt(3.0));
+  // Monte Carlo: within 5 standard errors of the closed form (a fixed seed: no flakiness).
+  const double se = cf.sd_out / std::sqrt(double(n));
+  EXPECT_NEAR(r.mean_out_to_in, cf.mean_out, 5 * se);
+  EXPECT_NEAR(r.chamfer, 0.5 * (h + cf.mean_out), 2.5 * se + 1e-12);
+  EXPECT_NEAR(r.chamfer_sq, 0.5 * (h * h + cf.mean_sq_out), 2.5 * cf.sd_sq_out / std::sqrt(double(n)));
+}
+
+TEST(EvalMetrics, CubeAgainstScaledCubeClosedForm) {
+  const PolyMesh cube = make_cube(3, 1.0);
+  const PolyMesh big = transformed(cube, 1.1, Vec3::Zero());
+  const EvalParams p = small_params(20000, 1000);
+  const EvalResult r = evaluate(cube, big, p);
+  EXPECT_EQ(r.scale, 1.0);
+  expect_cube_closed_form(r, p.samples);
+  // Sanity of the closed form itself: 82.6% of the outer area is at exactly h.
+  EXPECT_GT(CubeClosedForm().mean_out, 0.05);
+  EXPECT_LT(CubeClosedForm().mean_out, 0.05 * 1.1);
+}
+
+TEST(EvalMetrics, NormalisationUsesTheInputBoundingBox) {
+  // The same pair, 7× larger and far from the origin: identical metric values.
+  const Vec3 far(100, -3, 5);
+  const PolyMesh cube = transformed(make_cube(3, 1.0), 7.0, Vec3::Zero(), far);
+  const PolyMesh big = transformed(cube, 1.1, far);
+  const EvalParams p = small_params(10000, 1000);
+  const EvalResult r = evaluate(cube, big, p);
+  EXPECT_NEAR(r.scale, 1.0 / 7.0, 1e-15);
+  expect_cube_closed_form(r, p.samples);
+  // Swapping the roles changes the normalisation to the bigger cube: distances shrink by 1.1.
+  const EvalResult s = evaluate(big, cube, p);
+  EXPECT_NEAR(s.hausdorff, 0.05 * std::sqrt(3.0) / 1.1, 1e-12);
+  EXPECT_NEAR(s.hausdorff_out_to_in, 0.05 / 1.1, 1e-12);
+}
+
+TEST(EvalMetrics, QuadMeshAgainstItsFanTriangulation) {
+  for (const PolyMesh& m : {make_torus(12, 8), make_grid(9, 5), make_cube(3)}) {
+    const PolyMesh tri = fan_triangulated(m);
+    const EvalResult r = evaluate(m, tri, small_params(2000, 2000));
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_EQ(r.qpr, 0.0);
+    EXPECT_EQ(r.qpr_rule, "no_output_quads");
+    EXPECT_EQ(r.quad_fraction_out, 0.0);
+    EXPECT_LE(r.chamfer, 1e-12);
+    EXPECT_LE(r.hausdorff, 1e-12);
+    EXPECT_EQ(r.counts_in.tri_equivalent, r.counts_out.tri_equivalent);
+    // No chords on the output side: PCCD falls back to the documented penalty.
+    EXPECT_FALSE(r.pccd_defined);
+    EXPECT_EQ(r.chords_out, 0u);
+    EXPECT_EQ(r.pccd, 1.0);
+    // No output quads: flow undefined, coverage 0, JSON null.
+    EXPECT_TRUE(std::isnan(r.flow_deviation_deg));
+    EXPECT_EQ(r.flow_coverage, 0.0);
+    const nlohmann::json j = to_json(r);
+    EXPECT_TRUE(j["flow_deviation_deg"].is_null());
+    EXPECT_TRUE(j["pccd_in_to_out"].is_null());
+    EXPECT_EQ(j["pccd_defined"], false);
+    // The other way round: input without chords or quads.
+    const EvalResult back = evaluate(tri, m, small_params(2000, 2000));
+    EXPECT_EQ(back.qpr, 1.0);
+    EXPECT_EQ(back.qpr_rule, "no_input_quads");
+    EXPECT_EQ(back.pccd, 1.0);
+    EXPECT_FALSE(back.pccd_defined);
+    EXPECT_EQ(back.flow_coverage, 0.0);
+    // Both sides triangles: nothing to compare, PCCD 0, not defined.
+    const EvalResult tt = evaluate(tri, tri, small_params(2000, 2000));
+    EXPECT_EQ(tt.pccd, 0.0);
+    EXPECT_FALSE(tt.pccd_defined);
+  }
+}
+
+TEST(EvalMetrics, PccdOfGridShiftedInZIsTheShift) {
+  const double delta = 0.0123;
+  const PolyMesh grid = make_grid(8, 8);
+  const PolyMesh up = transformed(grid, 1.0, Vec3::Zero(), Vec3(0, 0, delta));
+  const EvalResult r = evaluate(grid, up, small_params());
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.scale, 1.0);
+  EXPECT_TRUE(r.pccd_defined);
+  EXPECT_EQ(r.chords_in, 16u);
+  EXPECT_NEAR(r.curve_length_in, 16.0, 1e-12);
+  EXPECT_NEAR(r.pccd_in_to_out, delta, 1e-12);
+  EXPECT_NEAR(r.pccd_out_to_in, delta, 1e-12);
+  EXPECT_NEAR(r.pccd, delta, 1e-12);
+  // Parallel planes: every surface distance is exactly delta too.
+  EXPECT_NEAR(r.chamfer, delta, 1e-12);
+  EXPECT_NEAR(r.chamfer_sq, delta * delta, 1e-15);
+  EXPECT_NEAR(r.hausdorff, delta, 1e-12);
+  EXPECT_EQ(r.flow_deviation_deg, 0.0);
+  EXPECT_EQ(r.flow_coverage, 1.0);
+}
+
+TEST(EvalMetrics, PccdOfGridAgainstTwiceFinerGrid) {
+  // Coarse n×n chords at odd multiples of 1/(2n); fine ones at odd multiples of 1/(4n).
+  //   coarse → fine: min(1/(4n), triangle wave in [0, 1/(4n)]) → mean 1/(8n);
+  //   fine → coarse: min(1/(4n), triangle wave in [0, 1/(2n)]) → mean 3/(16n).
+  // Quadrature bound: the midpoint rule with spacing h = L/N integrates a continuous piecewise-
+  // linear function with K kinks of slope jump <= 2 to within K·2h²/8, so the mean is within
+  // K·L/(4N²). Coarse side: L = 2n, K = 8n² + 2n; fine side: L = 4n, K = 16n² + 4n (the +
+  // are the junctions between concatenated curves, where the value is 1/(4n) on both sides)
+  // → both within 20n³/N².
+  const Index n = 5;
+  const std::uint64_t N = 20000;
+  const double bound = 20.0 * n * n * n / (double(N) * double(N));
+  const EvalResult r = evaluate(make_grid(n, n), make_grid(2 * n, 2 * n), small_params(2000, N));
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_NEAR(r.pccd_in_to_out, 1.0 / (8 * n), bound);
+  EXPECT_NEAR(r.pccd_out_to_in, 3.0 / (16 * n), bound);
+  EXPECT_NEAR(r.pccd, 5.0 / (32 * n), bound);
+  EXPECT_LE(r.chamfer, 1e-12);  // same plane, same square
+}
+
+PolyMesh rotated_about_z(const PolyMesh& m, double degrees, const Vec3& centre) {
+  PolyMesh out = m;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(degrees * std::numbers::pi / 180, Vec3::UnitZ()).toRotationMatrix();
+  for (Vec3& p : out.positions) p = centre + R * (p - centre);
+  return out;
+}
+
+TEST(EvalMetrics, FlowDeviationOfRotatedGridIsTheAngle) {
+  const PolyMesh grid = make_grid(10, 10);
+  const Vec3 centre(0.5, 0.5, 0);
+  // Lines are unoriented and the two directions may swap: deviation(α) = min(α, 90° − α) for
+  // α in [0°, 90°].
+  for (const auto& [angle, expected] : {std::pair{30.0, 30.0}, {60.0, 30.0}, {45.0, 45.0},
+                                        {10.0, 10.0}, {90.0, 0.0}, {-20.0, 20.0}}) {
+    const EvalResult r = evaluate(grid, rotated_about_z(grid, angle, centre), small_params(2000, 500));
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_NEAR(r.flow_deviation_deg, expected, 1e-9) << angle;
+    EXPECT_NEAR(r.flow_deviation_p90_deg, expected, 1e-9) << angle;
+    EXPECT_EQ(r.flow_coverage, 1.0) << angle;
+  }
+}
+
+TEST(EvalMetrics, FlowCoverageIsTheQuadAreaShare) {
+  // Left half of a 20×20 grid split into triangles: half the output area is on quads.
+  const PolyMesh grid = make_grid(20, 20);
+  PolyMesh half;
+  half.positions = grid.positions;
+  for (Index f = 0; f < grid.num_faces(); ++f) {
+    const auto v = grid.face_vertices(f);
+    if (face_centroid(grid, f).x() < 0.5) {
+      half.add_face({v[0], v[1], v[2]});
+      half.add_face({v[0], v[2], v[3]});
+    } else {
+      half.add_face({v[0], v[1], v[2], v[3]});
+    }
+  }
+  const EvalParams p = small_params();
+  const EvalResult r = evaluate(grid, half, p);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_NEAR(r.flow_coverage, 0.5, 5 * 0.5 / std::sqrt(double(p.samples)));
+  EXPECT_EQ(r.flow_deviation_deg, 0.0);
+  EXPECT_EQ(r.qpr, 200.0 / 600.0);
+  EXPECT_EQ(r.qpr_rule, "input_tri_free");
+  EXPECT_EQ(r.counts_out.tri_equivalent, 800u);
+  EXPECT_LE(r.chamfer, 1e-12);
+}
+
+TEST(EvalMetrics, DeterministicForASeedAndIndependentOfThreads) {
+  PolyMesh bumpy = make_torus(30, 16);
+  for (std::size_t i = 0; i < bumpy.positions.size(); ++i)
+    bumpy.positions[i] *= 1.0 + 0.02 * std::sin(7.0 * i);
+  const PolyMesh torus = make_torus(30, 16);
+  auto strip_times = [](nlohmann::json j) {
+    for (const char* k : {"seconds", "seconds_distance", "seconds_pccd", "threads"}) j.erase(k);
+    return j;
+  };
+  EvalParams p = small_params(3000, 2000);
+  p.threads = 1;
+  const nlohmann::json one = strip_times(to_json(evaluate(torus, bumpy, p)));
+  p.threads = 2;
+  const nlohmann::json two = strip_times(to_json(evaluate(torus, bumpy, p)));
+  p.threads = 3;
+  const nlohmann::json three = strip_times(to_json(evaluate(torus, bumpy, p)));
+  EXPECT_EQ(one, two);  // exact double equality of every field
+  EXPECT_EQ(one, three);
+  EXPECT_EQ(one.dump(17), two.dump(17));
+  p.seed = 2;
+  const EvalResult other = evaluate(torus, bumpy, p);
+  EXPECT_NE(other.chamfer, one["chamfer"].get<double>());
+  EXPECT_NE(other.mean_in_to_out, one["mean_in_to_out"].get<double>());
+  // Curve samples are not random: PCCD does not depend on the seed.
+  EXPECT_EQ(other.pccd, one["pccd"].get<double>());
+}
+
+TEST(EvalMetrics, ErrorsAreValues) {
+  const PolyMesh grid = make_grid(3, 3);
+  PolyMesh empty;
+  EXPECT_FALSE(evaluate(grid, empty).ok());
+  EXPECT_FALSE(evaluate(empty, grid).ok());
+  PolyMesh point;  // zero-size bbox
+  for (int i = 0; i < 3; ++i) point.add_vertex(Vec3(1, 1, 1));
+  point.add_face({0, 1, 2});
+  const EvalResult r = evaluate(point, grid, small_params(100, 100));
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.error.find("bounding box"), std::string::npos) << r.error;
+  EXPECT_TRUE(std::isnan(r.chamfer));
+  EXPECT_TRUE(to_json(r)["chamfer"].is_null());
+  PolyMesh nan = grid;
+  nan.positions[2].x() = std::nan("");
+  EXPECT_NE(evaluate(grid, nan, small_params(100, 100)).error.find("non-finite"), std::string::npos);
+  // Zero-area output (a collinear triangle).
+  PolyMesh line;
+  line.add_vertex({0, 0, 0});
+  line.add_vertex({1, 0, 0});
+  line.add_vertex({2, 0, 0});
+  line.add_face({0, 1, 2});
+  EXPECT_NE(evaluate(grid, line, small_params(100, 100)).error.find("zero surface area"),
+            std::string::npos);
+  PolyMesh bad = grid;
+  bad.corner_vertex[0] = 999;
+  EXPECT_NE(evaluate(grid, bad).error.find("output"), std::string::npos);
+}
+
+TEST(EvalMetrics, JsonHasEveryMetric) {
+  const nlohmann::json j = to_json(evaluate(make_demo_vase(12, 6), make_demo_vase(12, 6), small_params(1000, 1000)));
+  for (const char* k : {"chamfer", "chamfer_sq", "hausdorff", "hausdorff_in_to_out", "hausdorff_out_to_in",
+                        "qpr", "qpr_rule", "quad_fraction_in", "quad_fraction_out", "pccd", "pccd_defined",
+                        "flow_deviation_deg", "flow_deviation_p90_deg", "flow_coverage",
+                        "tri_equivalent_in", "tri_equivalent_out", "quads_in", "tris_out", "ngons_out",
+                        "scale", "seed", "samples_in", "seconds"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["ngons_in"], 1);
+  EXPECT_EQ(j["tris_in"], 12);
+  EXPECT_EQ(j["quads_in"], 72);
+  EXPECT_EQ(j["tri_equivalent_in"], 12 + 2 * 72 + 10);
+}
+
+// --- corpus ---------------------------------------------------------------------------------------------
+
+TEST(EvalCorpus, SuzanneAgainstItselfAndItsTriangulation) {
+  const auto path = std::filesystem::path(QUADLOD_CORPUS_DIR) / "blender_suzanne.obj";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "corpus not found at " << path;
+  const ReadResult rr = read_obj(path);
+  ASSERT_TRUE(rr.ok()) << rr.error;
+  const EvalResult self = evaluate(rr.mesh, rr.mesh, small_params());
+  ASSERT_TRUE(self.ok()) << self.error;
+  EXPECT_LE(self.chamfer, 1e-12);
+  EXPECT_LE(self.hausdorff, 1e-12);
+  EXPECT_LE(self.pccd, 1e-12);
+  EXPECT_EQ(self.qpr, 1.0);
+  EXPECT_EQ(self.qpr_rule, "ratio");
+  EXPECT_EQ(self.counts_in.quads, 468u);
+  EXPECT_EQ(self.counts_in.tris, 32u);
+  EXPECT_EQ(self.flow_deviation_deg, 0.0);
+  const EvalResult tri = evaluate(rr.mesh, fan_triangulated(rr.mesh), small_params());
+  EXPECT_EQ(tri.qpr, 0.0);
+  EXPECT_LE(tri.hausdorff, 1e-12);
+}
+
+// Timing over the whole corpus, each mesh against itself with default parameters. Not part of
+// the regular suite: run with
+//   quadlod_tests --gtest_also_run_disabled_tests --gtest_filter='EvalCorpus.DISABLED_*'
+TEST(EvalCorpus, DISABLED_TimeEveryCorpusMeshAgainstItself) {
+  const std::filesystem::path dir(QUADLOD_CORPUS_DIR);
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".obj") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  double total = 0, total_read = 0;
+  for (const auto& f : files) {
+    const ReadResult rr = read_obj(f);
+    ASSERT_TRUE(rr.ok()) << rr.error;
+    const EvalResult r = evaluate(rr.mesh, rr.mesh);
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_LE(r.chamfer, 1e-9) << f;
+    EXPECT_LE(r.pccd, 1e-9) << f;
+    std::printf("%-40s %7u faces  read %.2f s  eval %.2f s (dist %.2f, pccd %.2f)  chamfer %.2e  "
+                "hausdorff %.2e  pccd %.2e  flow %.3g deg  cover %.3f\n",
+                f.filename().c_str(), rr.mesh.num_faces(), rr.seconds, r.seconds,
+                r.seconds_distance, r.seconds_pccd, r.chamfer, r.hausdorff, r.pccd,
+                r.flow_deviation_deg, r.flow_coverage);
+    total += r.seconds;
+    total_read += rr.seconds;
+  }
+  std::printf("total: %zu meshes, read %.2f s, eval %.2f s\n", files.size(), total_read, total);
+}
+
+}  // namespace
+}  // namespace quadlod
