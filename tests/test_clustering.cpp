@@ -517,3 +517,28 @@ TEST(ClusterMeasure, DISABLED_MeasureAnalysisTime) {
     }
   }
 }
+
+TEST(AnalysisCluster, DISABLED_WholeCorpusInvariants) {
+  // Every corpus mesh through analyze() with all invariant checks (slow under sanitizers):
+  //   quadlod_tests --gtest_also_run_disabled_tests --gtest_filter='*DISABLED_WholeCorpus*'
+#ifdef QUADLOD_CORPUS_DIR
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(QUADLOD_CORPUS_DIR))
+    if (entry.path().extension() == ".obj") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) GTEST_SKIP() << "corpus not found";
+  for (const auto& path : files) {
+    PolyMesh mesh;
+    ASSERT_TRUE(load_corpus(path.filename().string(), mesh)) << path;
+    const Fixture f = make_fixture(path.filename().string(), std::move(mesh));
+    const AnalysisResult a = analyze(f.mesh, f.conn);
+    expect_polychord_invariants(f, a.polychords);
+    expect_segmentation_invariants(f, a.polychords, a.segmentation, {});
+    expect_medial_invariants(f, a.polychords, a.medial);
+    expect_triangle_invariants(f, a.triangles);
+    std::printf("%s\n", (f.name + ": " + analysis_summary(f.mesh, a)).c_str());
+  }
+#else
+  GTEST_SKIP() << "no corpus";
+#endif
+}

@@ -11,8 +11,9 @@
 //     │     └─ nearest point on the other mesh (parallel, one slot per sample) ─► Chamfer, Hausdorff
 //     │                                                                      └─► flow (output side)
 //     └─ poly-chords ─► medial curves ─► arc-length samples ─► SegmentBvh ─► PCCD
-// Every parallel loop writes one slot per sample and every reduction runs serially in sample
-// order afterwards, so the numbers do not depend on the thread count.
+// Queries run in fixed chunks of Morton-ordered points, each chunk warm-starting every search
+// from the previous answer; every query writes its own slot and every reduction runs serially in
+// sample order afterwards, so the numbers do not depend on the thread count (docs/metrics.md §7).
 #include "quadlod/metrics.h"
 
 #include "geometry/bvh.h"

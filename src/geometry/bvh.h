@@ -1,9 +1,9 @@
 // Bounding volume hierarchies for exact nearest-point queries against triangles and segments
 // (the distance oracles of `quadlod eval`: Chamfer, Hausdorff, PCCD, flow; docs/metrics.md).
 //
-// One tree kernel (`Bvh`) over axis-aligned boxes, built by binned SAH, queried iteratively with
-// an explicit stack, nearest child first, pruning every node whose box is farther than the best
-// hit so far. Two thin wrappers own the primitives:
+// One tree kernel (`Bvh`) over axis-aligned boxes, built by binned SAH (longest centroid axis),
+// queried iteratively with an explicit stack, nearest child first, pruning every node whose box
+// is not strictly nearer than the best hit so far. Two thin wrappers own the primitives:
 //   * TriangleBvh: closest point on a set of triangles (the Voronoi-region method of Ericson,
 //     "Real-Time Collision Detection" §5.1.5, evaluated in a per-triangle orthonormal frame so
 //     that slivers and zero-area triangles stay exact, see TriangleFrame);
@@ -11,9 +11,11 @@
 //
 // Exactness: the answer is the minimum of the same per-primitive function a brute-force loop
 // evaluates (closest_point_on_triangle / closest_point_on_segment below); boxes are exact
-// min/max of the primitive's coordinates, so pruning never discards the minimiser except by a
-// rounding tie (distances then agree to within a few ulps). tests/test_bvh.cpp checks this
-// against brute force.
+// min/max of the primitive's coordinates, so pruning never discards the minimiser except when a
+// box distance and a triangle distance round differently by an ulp (distances then agree to
+// ~1e-16 of the coordinates; tests/test_bvh.cpp checks <= 1e-14 against brute force).
+//
+// Thread safety: queries are const and touch no shared mutable state; run them concurrently.
 #pragma once
 
 #include "quadlod/mesh.h"

@@ -14,8 +14,10 @@
 //               p0 ──e0── x ─────e2───── p3 ──e3── p4
 //                  C(e0)+C(e1)  C(e2)      C(e3)                    (if e0's centre was nearer)
 //
-// The spatial check measures every original point spanned by the edges around the collapse
-// (u..c below) against the new two-edge polyline u → x → c; the rest of the curve is unchanged.
+// The spatial check measures the original points spanned by the two edges around the collapse
+// against the edge that will span them (u..a against u → x, a..c against x → c below); the rest
+// of the curve is unchanged. Upper bounds kept per edge (and, for the normal criteria, per
+// cluster) make most checks O(1); an exact scan runs only when a bound exceeds the limit.
 //
 //        u ──prev── a ──k── b ──next── c      ⇒      u ──── x ──── c
 #include "geometry/medial_clustering.h"
@@ -53,6 +55,8 @@ class CurveClusterer {
     setup(chord);
     simplify();
     emit(chord_id, chord);
+    out_.stats.exact_spatial_checks = exact_spatial_checks_;
+    out_.stats.exact_normal_checks = exact_normal_checks_;
   }
 
  private:
@@ -81,6 +85,9 @@ class CurveClusterer {
     cluster_first_.resize(m_);
     cluster_last_.resize(m_);
     normal_sum_.resize(m_);
+    deviation_.assign(m_, 0.0);
+    spread_.assign(m_, 0.0);
+    rejected_.assign(m_, 0);
     for (Index i = 0; i < m_; ++i) {
       start_[i] = i;
       end_[i] = (i + 1) % num_points();
@@ -109,6 +116,7 @@ class CurveClusterer {
 
   void push(Index k) {
     ++version_[k];
+    rejected_[k] = 0;
     heap_.push({collapse_point(k).error, k, version_[k]});
   }
 
@@ -123,47 +131,92 @@ class CurveClusterer {
     }
   }
 
-  // Spatial deviation of the original points spanned by prev, k and next from u → x → c.
-  bool spatial_ok(Index k, const Vec3& x) const {
-    const Index p = prev_[k], n = next_[k];
-    const Index from = p != kInvalidIndex ? start_[p] : start_[k];
-    const Index to = n != kInvalidIndex ? end_[n] : end_[k];
-    const Vec3 u = pos_[from], c = pos_[to];
+  // Largest distance of the original points strictly between ids first and last (cyclic) from
+  // segment [s0, s1]; 0 when there are none.
+  double interior_deviation(Index first, Index last, const Vec3& s0, const Vec3& s1) const {
     const Index np = num_points();
-    // Points from..to along the curve; on a closed curve of three edges u == c and the range is
-    // the whole loop.
-    Index count = closed_ ? (to + np - from) % np + 1 : to - from + 1;
-    if (closed_ && from == to) count = np;
-    for (Index j = from, left = count; left > 0; --left, j = (j + 1) % np) {
-      const Vec3& q = orig_[j];
-      double d = std::numeric_limits<double>::infinity();
-      if (p != kInvalidIndex) d = point_segment_distance(q, u, x);
-      if (n != kInvalidIndex) d = std::min(d, point_segment_distance(q, x, c));
-      if (d > max_deviation_) return false;
-    }
-    return true;
+    double worst = 0.0;
+    for (Index j = (first + 1) % np; j != last; j = (j + 1) % np)
+      worst = std::max(worst, point_segment_distance(orig_[j], s0, s1));
+    return worst;
   }
 
-  Verdict check_normals(Index k, Index target) const {
-    // Normal deviation between the two merging clusters.
-    const Vec3 na = normal_sum_[k], nb = normal_sum_[target];
-    if (na.squaredNorm() > 0.0 && nb.squaredNorm() > 0.0 &&
-        na.normalized().dot(nb.normalized()) < cos_deviation_)
-      return Verdict::NormalDeviation;
+  // Spatial criterion for collapsing k = ⟨a, b⟩ to x with vertex `keep` surviving:
+  //
+  //      u ──p── a ──k── b ──n── c     ⇒     u ──P'── x ──N'── c        (keep = a: b's point and
+  //                                                                      k's interior join N')
+  // Every original point must stay within max_deviation_ of the simplified curve: an interior
+  // point of an edge's span of its own edge, a vertex's point of the nearer adjacent edge. The
+  // vertex points of u, keep and c are checked exactly (O(1)). For interior points `deviation_`
+  // keeps an upper bound per edge, and O(1) bounds (a point moves with its edge by at most the
+  // distance its edge's end moved; points of a segment are within its farther endpoint's
+  // distance of another segment) decide most cases; the exact scan decides the rest. On success
+  // the new edges' interior bounds are returned.
+  bool spatial_ok(Index k, const Vec3& x, Index keep, double& dev_prev, double& dev_next) const {
+    const Index p = prev_[k], n = next_[k];
+    const Index a = start_[k], b = end_[k];
+    const Index removed = keep == a ? b : a;
+    const Vec3 u = p != kInvalidIndex ? pos_[start_[p]] : x;
+    const Vec3 c = n != kInvalidIndex ? pos_[end_[n]] : x;
+    // Vertex points. P' replaces p, N' replaces n (k itself disappears).
+    auto vertex_ok = [&](Index v, Index e0, Index e1) {
+      double d = std::numeric_limits<double>::infinity();
+      for (Index e : {e0, e1}) {
+        if (e == kInvalidIndex) continue;
+        if (e == p) d = std::min(d, point_segment_distance(orig_[v], u, x));
+        else if (e == n) d = std::min(d, point_segment_distance(orig_[v], x, c));
+        else d = std::min(d, point_segment_distance(orig_[v], pos_[start_[e]], pos_[end_[e]]));
+      }
+      return d == std::numeric_limits<double>::infinity() || d <= max_deviation_;
+    };
+    if (!vertex_ok(keep, p, n)) return false;
+    if (p != kInvalidIndex && !vertex_ok(start_[p], prev_[p], p)) return false;
+    if (n != kInvalidIndex && !vertex_ok(end_[n], n, next_[n])) return false;
 
-    // Normal variation inside the merged cluster.
-    const Vec3 sum = na + nb;
-    if (sum.squaredNorm() > 0.0) {
-      const Vec3 avg = sum.normalized();
-      bool ok = true;
-      auto test = [&](Index i) {
-        if (ok && normals_[i].squaredNorm() > 0.0 && normals_[i].dot(avg) < cos_variation_) ok = false;
-      };
-      for_cluster_quads(k, test);
-      for_cluster_quads(target, test);
-      if (!ok) return Verdict::NormalVariation;
-    }
-    return Verdict::Accept;
+    // Interior points: bounds first.
+    dev_prev = p != kInvalidIndex ? deviation_[p] + (pos_[a] - x).norm() : 0.0;
+    dev_next = n != kInvalidIndex ? deviation_[n] + (pos_[b] - x).norm() : 0.0;
+    const Vec3& s0 = keep == a ? x : u;  // the new edge that takes k's points and `removed`
+    const Vec3& s1 = keep == a ? c : x;
+    const double joined =
+        std::max(deviation_[k] + std::max(point_segment_distance(pos_[a], s0, s1), point_segment_distance(pos_[b], s0, s1)),
+                 point_segment_distance(orig_[removed], s0, s1));
+    (keep == a ? dev_next : dev_prev) = std::max(keep == a ? dev_next : dev_prev, joined);
+    if (dev_prev <= max_deviation_ && dev_next <= max_deviation_) return true;
+    ++exact_spatial_checks_;
+    if (p != kInvalidIndex) dev_prev = interior_deviation(start_[p], keep, u, x);
+    if (n != kInvalidIndex) dev_next = interior_deviation(keep, end_[n], x, c);
+    return dev_prev <= max_deviation_ && dev_next <= max_deviation_;
+  }
+
+  static double angle(const Vec3& unit_a, const Vec3& unit_b) {
+    return std::acos(std::clamp(unit_a.dot(unit_b), -1.0, 1.0));
+  }
+
+  // Normal criteria for merging cluster k into cluster `target`. `spread_` holds an upper bound
+  // of the angle between a cluster's quad normals and its average; by the triangle inequality on
+  // the sphere a merged cluster's spread is at most max(spread_X + ∠(avg_X, avg_new)) over its two
+  // parts, which decides most cases in O(1); otherwise the quads are scanned.
+  Verdict check_normals(Index k, Index target, double& spread) const {
+    const Vec3 sa = normal_sum_[k], sb = normal_sum_[target];
+    spread = std::max(spread_[k], spread_[target]);
+    if (sa.squaredNorm() == 0.0 || sb.squaredNorm() == 0.0) return Verdict::Accept;  // degenerate quads
+    const Vec3 na = sa.normalized(), nb = sb.normalized();
+    if (na.dot(nb) < cos_deviation_) return Verdict::NormalDeviation;
+    const Vec3 sum = sa + sb;
+    if (sum.squaredNorm() == 0.0) return Verdict::NormalVariation;
+    const Vec3 avg = sum.normalized();
+    spread = std::max(spread_[k] + angle(na, avg), spread_[target] + angle(nb, avg));
+    if (spread <= params_.max_normal_variation) return Verdict::Accept;
+    ++exact_normal_checks_;
+    double min_dot = 1.0;
+    auto scan = [&](Index i) {
+      if (normals_[i].squaredNorm() > 0.0) min_dot = std::min(min_dot, normals_[i].dot(avg));
+    };
+    for_cluster_quads(k, scan);
+    for_cluster_quads(target, scan);
+    spread = std::acos(std::clamp(min_dot, -1.0, 1.0));
+    return min_dot < cos_variation_ ? Verdict::NormalVariation : Verdict::Accept;
   }
 
   void simplify() {
@@ -189,31 +242,41 @@ class CurveClusterer {
         if ((centre(n) - ck).squaredNorm() < (centre(p) - ck).squaredNorm()) std::swap(target, other);
       }
       const Quadric::Minimum x = collapse_point(k);
-      if (!spatial_ok(k, x.point)) {
+      // Curve: keep the vertex on the side that has no neighbour (open ends stay put), else a.
+      const Index a = start_[k], b = end_[k];
+      const Index keep = n == kInvalidIndex ? b : a;
+      double dev_prev = 0.0, dev_next = 0.0;
+      if (!spatial_ok(k, x.point, keep, dev_prev, dev_next)) {
         ++s.rejected_spatial_deviation;
+        rejected_[k] = 1;
         continue;
       }
-      const Verdict verdict = check_normals(k, target);
+      double spread = 0.0;
+      const Verdict verdict = check_normals(k, target, spread);
       if (verdict != Verdict::Accept) {
-        if (other != kInvalidIndex && check_normals(k, other) == Verdict::Accept) {
+        if (other != kInvalidIndex && check_normals(k, other, spread) == Verdict::Accept) {
           target = other;
           ++s.merged_into_farther;
         } else {
           if (verdict == Verdict::NormalDeviation) ++s.rejected_normal_deviation;
           else ++s.rejected_normal_variation;
+          rejected_[k] = 1;
           continue;
         }
       }
 
-      // Curve: keep the vertex on the side that has no neighbour (open ends stay put), else a.
-      const Index a = start_[k], b = end_[k];
-      const Index keep = n == kInvalidIndex ? b : a;
       pos_[keep] = x.point;
       quadric_[keep] = quadric_[a] + quadric_[b];
-      if (p != kInvalidIndex) end_[p] = keep;
-      if (n != kInvalidIndex) start_[n] = keep;
-      if (p != kInvalidIndex) next_[p] = n;
-      if (n != kInvalidIndex) prev_[n] = p;
+      if (p != kInvalidIndex) {
+        end_[p] = keep;
+        next_[p] = n;
+        deviation_[p] = dev_prev;
+      }
+      if (n != kInvalidIndex) {
+        start_[n] = keep;
+        prev_[n] = p;
+        deviation_[n] = dev_next;
+      }
       alive_[k] = 0;
       --alive_count_;
       ++s.num_collapses;
@@ -222,17 +285,14 @@ class CurveClusterer {
       if (target == p) cluster_last_[p] = cluster_last_[k];
       else cluster_first_[n] = cluster_first_[k];
       normal_sum_[target] += normal_sum_[k];
+      spread_[target] = spread;
 
-      // Costs changed around the moved vertex; criteria changed one step further out.
-      const Index around[4] = {p, n, p != kInvalidIndex ? prev_[p] : kInvalidIndex,
-                               n != kInvalidIndex ? next_[n] : kInvalidIndex};
-      for (int i = 0; i < 4; ++i) {
-        const Index e = around[i];
-        if (e == kInvalidIndex || !alive_[e]) continue;
-        bool seen = false;
-        for (int j = 0; j < i; ++j) seen |= around[j] == e;
-        if (!seen) push(e);
-      }
+      // Costs changed around the moved vertex (prev, next); one step further out only the
+      // legality changed, which matters to edges that were rejected before.
+      if (p != kInvalidIndex) push(p);
+      if (n != kInvalidIndex && n != p) push(n);
+      for (Index e : {p != kInvalidIndex ? prev_[p] : kInvalidIndex, n != kInvalidIndex ? next_[n] : kInvalidIndex})
+        if (e != kInvalidIndex && e != p && e != n && alive_[e] && rejected_[e]) push(e);
     }
   }
 
@@ -297,8 +357,12 @@ class CurveClusterer {
   std::vector<Vec3> orig_, pos_, normals_;
   std::vector<Quadric> quadric_;
   std::vector<Index> start_, end_, prev_, next_, version_, cluster_first_, cluster_last_;
-  std::vector<std::uint8_t> alive_;
+  std::vector<std::uint8_t> alive_, rejected_;
   std::vector<Vec3> normal_sum_;
+  std::vector<double> deviation_;  // per edge: bound on its original points' distance to it
+  std::vector<double> spread_;     // per cluster: bound on its quad normals' angle to its average
+  mutable std::size_t exact_spatial_checks_ = 0;
+  mutable std::size_t exact_normal_checks_ = 0;
   Index alive_count_ = 0;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap_;
 };

@@ -25,7 +25,7 @@
 // rejects one candidate collapse (the candidate stays, the next cheapest is tried; it is tried
 // again when a neighbour changes) and is counted in the stats:
 //   * spatial deviation: an original medial point would lie farther than
-//     max_spatial_deviation · bbox_diagonal from the simplified curve;
+//     max_spatial_deviation · bbox_diagonal from the simplified medial edge that spans it;
 //   * normal deviation: the angle between the two merging clusters' normals exceeds
 //     max_normal_deviation;
 //   * normal variation: some quad normal of the merged cluster deviates from the merged cluster
@@ -43,6 +43,7 @@
 #include "quadlod/mesh.h"
 #include "topology/polychords.h"
 
+#include <cstddef>
 #include <numbers>
 #include <vector>
 
@@ -79,6 +80,10 @@ struct MedialClusteringStats {
   Index duplicate_loopy_edges = 0;        ///< loopy edges seen again along the same chord
   Index empty_clusters_dropped = 0;       ///< clusters whose every edge was a duplicate
   Index largest_cluster = 0;              ///< most quads (medial edges) merged into one cluster
+  /// Criterion checks that the O(1) bounds could not decide (a scan of the spanned points /
+  /// the clusters' quads ran); a cost indicator only.
+  std::size_t exact_spatial_checks = 0;
+  std::size_t exact_normal_checks = 0;
 };
 
 struct MedialClusteringResult {

@@ -53,6 +53,7 @@ TriangleClusteringResult cluster_triangle_regions(const PolyMesh& mesh, const Co
     for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) borders[conn.corner_edge[c]] = 1;
   }
   std::deque<Index> queue;
+  std::vector<std::uint8_t> vertex_done(nv, 0);  // its corners scanned once: linear time
   for (Index e0 = 0; e0 < ne; ++e0) {
     if (!borders[e0] || out.edge_region[e0] != kInvalidIndex) continue;
     const Index region = out.stats.num_regions++;
@@ -61,13 +62,16 @@ TriangleClusteringResult cluster_triangle_regions(const PolyMesh& mesh, const Co
     while (!queue.empty()) {
       const Index e = queue.front();
       queue.pop_front();
-      for (Index v : conn.edge_vertices[e])
+      for (Index v : conn.edge_vertices[e]) {
+        if (vertex_done[v]) continue;
+        vertex_done[v] = 1;
         for (Index c : conn.corners_at_vertex(v))
           for (Index g : {conn.corner_edge[c], conn.corner_edge[conn.corner_prev[c]]})
             if (borders[g] && out.edge_region[g] == kInvalidIndex) {
               out.edge_region[g] = region;
               queue.push_back(g);
             }
+      }
     }
   }
 
