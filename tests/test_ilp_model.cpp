@@ -697,3 +697,22 @@ TEST(IlpSolverFactory, KnowsCbcAndListsBackendsForUnknownNames) {
 }
 
 }  // namespace
+
+TEST(IlpCbc, StartAsCutoffProvenOptimal) {
+  // minimise -x0 - x1/2 subject to x0 + x1 <= 1: the start (1, 0) is the unique optimum.
+  // Handed over as a cutoff, CBC finds nothing better; the finished search proves it optimal.
+  Model m;
+  const Col x0 = m.add_binary(-1.0);
+  const Col x1 = m.add_binary(-0.5);
+  m.add_le({{x0, 1.0}, {x1, 1.0}}, 1.0);
+  m.set_initial_solution({1.0, 0.0});
+  SolveParams params;
+  params.time_limit_seconds = 30.0;
+  params.start_as_mip_start = false;
+  const SolveResult r = solve(m, params);
+  EXPECT_EQ(r.start, StartStatus::NotUsed);
+  EXPECT_EQ(r.status, SolveStatus::Optimal) << describe(r);
+  ASSERT_TRUE(r.has_solution());
+  EXPECT_DOUBLE_EQ(r.objective, -1.0);
+  EXPECT_EQ(r.solution, (std::vector<double>{1.0, 0.0}));
+}

@@ -54,6 +54,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_edge()))->group("Paper parameters");
   sub->add_option("--max-hausdorff", p.max_hausdorff, "Bound on moved vertices' distance, relative to the bbox diagonal (0 = off)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group("Guarantees");
+  sub->add_option("--max-rounds", p.max_rounds,
+                  "Selection/collapse rounds: later rounds pin refused collapses and re-aim at the target")
+      ->check(CLI::Range(1, 64))->capture_default_str()->group("Guarantees");
   sub->add_flag("--no-consistency", opt->no_consistency, "Ablation: drop Eq. 4")->group("Ablations");
   sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
@@ -102,11 +105,12 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             const auto& rep = r.report;
             std::printf(
                 "simplify: target %llu, achieved %llu (%+.1f%%), %u quads, %u tris, %u n-gons; "
-                "analysis %.2f s, select %.2f s, dual %.2f s, collapse %.2f s, total %.2f s\n",
+                "analysis %.2f s, select %.2f s, dual %.2f s, collapse %.2f s (%zu rounds), total %.2f s\n",
                 static_cast<unsigned long long>(r.target), static_cast<unsigned long long>(r.achieved),
                 100.0 * rep["deviation"].get<double>(), r.quads, r.triangles, r.ngons,
-                rep["analysis"]["seconds"].get<double>(), rep["selection"]["seconds"].get<double>(),
-                rep["dual_repair"]["seconds"].get<double>(), rep["collapse"]["seconds"].get<double>(),
+                rep["stage_seconds"]["analysis"].get<double>(), rep["stage_seconds"]["select"].get<double>(),
+                rep["stage_seconds"]["dual"].get<double>(), rep["stage_seconds"]["collapse"].get<double>(),
+                rep["rounds"].size(),
                 read_seconds + rep["seconds"].get<double>() + write_seconds);
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;

@@ -38,6 +38,15 @@ struct SimplifyOptions {
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
   std::string solver = "cbc";
 
+  // --- rounds (beyond the paper) ------------------------------------------------------------
+  /// Selection → repair → collapse rounds: a round after the first pins the edges whose collapse
+  /// was refused and re-aims the selection by the count drift (src/pipeline/simplify.cpp).
+  int max_rounds = 4;
+  /// Stop once the output is within this fraction of the target.
+  double round_tolerance = 0.01;
+  /// MIP budget of each round after the first, as a fraction of `time_limit_seconds`.
+  double later_round_time_fraction = 0.25;
+
   // --- ablations (paper Table 2) ----------------------------------------------------------------
   bool consistency = true;   ///< Eq. 4
   bool segmentation = true;  ///< §3.2.2
@@ -61,6 +70,7 @@ struct SimplifyResult {
   std::uint64_t target = 0;
   std::uint64_t achieved = 0;  ///< tri-equivalents of `mesh`
   Index quads = 0, triangles = 0, ngons = 0;
+  int rounds_used = 0;  ///< the selection → collapse round whose output this is
   /// Everything measured on the way: per-stage seconds, analysis counts, model sizes, solver
   /// status / objective / bound / gap, repair and collapse statistics.
   nlohmann::json report;

@@ -219,12 +219,13 @@ struct RunOutcome {
   bool root_lp_infeasible = false;
   bool root_lp_stopped = false;
   bool incumbent_before_search = false;
+  bool time_limit_reached = false;
   ModelSize presolved;
   std::string error;  // CBC threw
 };
 
 RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolveParams& params,
-                   double time_limit, bool preprocess, bool use_start, RunContext& run) {
+                   double time_limit, bool preprocess, bool use_start, double cutoff, RunContext& run) {
   RunOutcome out;
   const Col n = model.num_cols();
 
@@ -265,12 +266,14 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   const std::string gap = arg(params.relative_gap);
   // CBC reads seed 0 as "seed from the clock"; keep runs repeatable.
   const std::string seed = std::to_string(std::max<std::uint32_t>(1, params.seed % INT_MAX));
+  const std::string cutoff_arg = arg(cutoff);
   std::vector<const char*> argv = {"quadlod", "-log", log.c_str(), "-slog", slog.c_str(),
                                    "-timeMode", "elapsed", "-ratioGap", gap.c_str(),
                                    "-randomCbcSeed", seed.c_str()};
   if (std::isfinite(time_limit)) argv.insert(argv.end(), {"-sec", seconds.c_str()});
   if (backend::resolve_threads(params) > 1) argv.insert(argv.end(), {"-threads", threads.c_str()});
   if (!preprocess) argv.insert(argv.end(), {"-preprocess", "off"});
+  if (std::isfinite(cutoff)) argv.insert(argv.end(), {"-cutoff", cutoff_arg.c_str()});
   argv.insert(argv.end(), {"-solve", "-quit"});
 
   run.root_lp_infeasible = run.root_lp_stopped = run.reached_branch_and_bound = false;
@@ -295,6 +298,7 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   out.presolved = run.presolved;
   if (!out.error.empty()) return out;
 
+  out.time_limit_reached = cbc.isSecondsLimitReached() || run.root_lp_stopped;
   out.nodes = cbc.getNodeCount();
   out.iterations = cbc.getIterationCount();
   // An interrupted dual simplex leaves an objective value that is not a proven bound.
@@ -378,10 +382,26 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
 
   const bool use_start = start_fits && params.start_as_mip_start;
   if (start_fits && !use_start) result.start = StartStatus::NotUsed;
+  // A start that is not handed over as MIP start still bounds the search: CBC only looks for
+  // solutions better than it ("-cutoff"), and a search that ends without one proves the start
+  // optimal (the floor in backend::finish returns it).
+  double cutoff = kInf;
+  if (start_fits && !use_start && model.is_feasible(model.initial_solution(), params.feasibility_tolerance)) {
+    const double start_obj = model.evaluate(model.initial_solution());
+    cutoff = start_obj + 1e-7 * std::max(1.0, std::abs(start_obj));
+  }
   // The budget counts from entry into solve(): converting and loading a big model takes a
   // noticeable part of it (about 1 s for 1.45M nonzeros).
   const double budget = std::max(1e-3, params.time_limit_seconds - seconds_since(t0));
-  RunOutcome out = run_cbc(model, problem, params, budget, /*preprocess=*/true, use_start, run);
+  RunOutcome out = run_cbc(model, problem, params, budget, /*preprocess=*/true, use_start, cutoff, run);
+  if (std::isfinite(cutoff) && out.status == SolveStatus::Infeasible && out.error.empty()) {
+    // Nothing better than the start exists (search complete) or was found (time ran out).
+    // Only a finished search or an infeasible root LP proves it; pre-processing cut short by the
+    // time limit also says "infeasible" (see the header comment).
+    const bool proven = (out.reached_branch_and_bound && !out.time_limit_reached) || out.root_lp_infeasible;
+    out.status = proven ? SolveStatus::Optimal : SolveStatus::NoSolution;
+    if (out.status == SolveStatus::Optimal) out.best_bound = cutoff;
+  }
   result.presolved = out.presolved;
   if (use_start && out.reached_branch_and_bound)
     result.start = out.incumbent_before_search ? StartStatus::Accepted : StartStatus::Rejected;
@@ -396,7 +416,7 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
       out.status = SolveStatus::NoSolution;
     } else {
       const std::int64_t nodes = out.nodes, iterations = out.iterations;
-      out = run_cbc(model, problem, params, remaining, /*preprocess=*/false, use_start, run);
+      out = run_cbc(model, problem, params, remaining, /*preprocess=*/false, use_start, cutoff, run);
       out.nodes += nodes;
       out.iterations += iterations;
       backend::note(result, CallStatus::Warning,

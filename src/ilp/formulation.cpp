@@ -118,6 +118,7 @@ Groups make_groups(const Connectivity& conn, const AnalysisResult& analysis,
   for (Index e = 0; e < conn.num_edges; ++e) {
     g.importance[g.edge_group[e]] += importance[e];
     if (params.keep_nonmanifold_edges && conn.is_nonmanifold_edge(e)) g.fixed[g.edge_group[e]] = 1;
+    if (!params.keep_edges.empty() && params.keep_edges[e]) g.fixed[g.edge_group[e]] = 1;
   }
   return g;
 }
@@ -323,6 +324,13 @@ class ModelBuilder {
       : mesh_(mesh), conn_(conn), analysis_(analysis), g_(groups), gc_(gc), fg_(fg),
         importance_(importance), params_(params) {}
 
+  /// Restricts the model to a neighbourhood (fast formulation only): groups with free[g] = 0
+  /// are fixed to base[g]; faces and clusters that touch no free group become constants.
+  void set_scope(const std::vector<std::uint8_t>& free, const std::vector<std::uint8_t>& base) {
+    free_ = &free;
+    base_ = &base;
+  }
+
   void build(std::uint64_t target, bool band) {
     exact_ = params_.formulation == Formulation::Exact;
     if (exact_) build_exact_vars();
@@ -368,11 +376,19 @@ class ModelBuilder {
       x[c.var] = all_collapsed ? 1.0 : 0.0;
     }
     for (const TriCluster& c : tri_) {
+      if (c.var == kNone) continue;
       bool any_collapsed = false;
       for (Col col : c.cols) any_collapsed |= x[col] < 0.5;
       x[c.var] = any_collapsed ? 1.0 : 0.0;
     }
     return x;
+  }
+
+  /// Group values of a fast-formulation solution (rounded).
+  std::vector<std::uint8_t> group_bits(const std::vector<double>& x) const {
+    std::vector<std::uint8_t> y(g_.count);
+    for (Index grp = 0; grp < g_.count; ++grp) y[grp] = x[group_col_[grp]] > 0.5;
+    return y;
   }
 
   /// Group values back from a solution (rounded).
@@ -411,8 +427,9 @@ class ModelBuilder {
   void build_fast_vars() {
     group_col_.resize(g_.count);
     for (Index grp = 0; grp < g_.count; ++grp) {
-      const double lo = g_.fixed[grp] ? 1.0 : 0.0;
-      group_col_[grp] = model.add_var(ilp::VarType::Binary, lo, 1.0,
+      double lo = g_.fixed[grp] ? 1.0 : 0.0, hi = 1.0;
+      if (free_ && !(*free_)[grp]) lo = hi = (*base_)[grp];
+      group_col_[grp] = model.add_var(ilp::VarType::Binary, lo, hi,
                                       -params_.lambda_edge * g_.importance[grp]);
     }
     stats.edge_groups = g_.count;
@@ -450,6 +467,10 @@ class ModelBuilder {
     std::vector<double> owner_constant(model.num_cols(), 0.0), owner_upper(model.num_cols(), 0.0);
     std::vector<Index> owned(model.num_cols(), 0);
     for (Index f = 0; f < mesh_.num_faces(); ++f) {
+      if (free_ && !face_touches_free(f)) {
+        count_constant_ += double(face_count(fg_, f, *base_));
+        continue;
+      }
       const double k = mesh_.face_size(f);
       std::vector<Term> terms = face_terms(f);
       if (!exact_) {
@@ -525,6 +546,12 @@ class ModelBuilder {
     }
   }
 
+  bool face_touches_free(Index f) const {
+    for (Index i = fg_.offsets[f]; i < fg_.offsets[f + 1]; ++i)
+      if ((*free_)[fg_.group[i]]) return true;
+    return false;
+  }
+
   double group_size(Col col) const {
     // Only called in fast mode, where columns of groups are the first g_.count columns.
     const Index grp = static_cast<Index>(col);
@@ -588,6 +615,15 @@ class ModelBuilder {
       // Only the binding side: with λ_geo > 0 a minimiser never raises x_C above what
       // x_C ≥ 1 − Σ y forces, so x_C ≤ 1 − y rows are redundant at every optimum.
       for (const auto& groups : gc_.geo) {
+        if (free_) {
+          // Outside the neighbourhood, or kept by a fixed group: a constant of the objective.
+          bool any_free = false, kept = false;
+          for (Index grp : groups) {
+            any_free |= (*free_)[grp] != 0;
+            kept |= !(*free_)[grp] && (*base_)[grp];
+          }
+          if (!any_free || kept) continue;
+        }
         const Col xc = model.add_continuous(0.0, 1.0, params_.lambda_geo);
         std::vector<Term> row{{xc, 1.0}};
         std::vector<Col> cols;
@@ -604,8 +640,24 @@ class ModelBuilder {
 
   // Eqs. 7–8: x_Ct = 1 iff some edge of C_t is collapsed; then every neighbour keeps all edges.
   void build_tri_clusters() {
-    std::vector<std::vector<Col>> cols_of(analysis_.triangles.clusters.size());
+    const std::size_t nt = analysis_.triangles.clusters.size();
+    // In a neighbourhood only clusters with a free group and their Eq. 8 partners take part.
+    std::vector<std::uint8_t> active(nt, 1), needed(nt, 1);
+    if (free_) {
+      for (std::size_t i = 0; i < nt; ++i) {
+        active[i] = 0;
+        for (Index grp : gc_.tri[i]) active[i] |= (*free_)[grp];
+      }
+      needed = active;
+      for (const auto& [i, j] : analysis_.triangles.neighbours)
+        if (active[i] || active[j]) needed[i] = needed[j] = 1;
+    }
+    std::vector<std::vector<Col>> cols_of(nt);
     for (std::size_t i = 0; i < cols_of.size(); ++i) {
+      if (!needed[i]) {
+        tri_.push_back({kNone, {}});
+        continue;
+      }
       auto& cols = cols_of[i];
       for (Index e : analysis_.triangles.clusters[i].edges) cols.push_back(edge_col(e));
       std::sort(cols.begin(), cols.end());
@@ -628,13 +680,15 @@ class ModelBuilder {
       tri_.push_back({var, cols});
     }
     for (const auto& [i, j] : analysis_.triangles.neighbours) {
+      if (!active[i] && !active[j]) continue;
       const auto& cj = cols_of[j];
       std::vector<Term> row{{tri_[i].var, double(cj.size())}};
       for (Col c : cj) row.push_back({c, -1.0});
       model.add_le(row, 0.0);  // Eq. 8: |C_j| x_Ct(i) ≤ Σ_{e ∈ C_j} x_e
       ++stats.tri_neighbour_rows;
     }
-    stats.tri_clusters = static_cast<Index>(tri_.size());
+    stats.tri_clusters = static_cast<Index>(
+        std::count_if(tri_.begin(), tri_.end(), [](const TriCluster& c) { return c.var != kNone; }));
   }
 
   const PolyMesh& mesh_;
@@ -646,6 +700,8 @@ class ModelBuilder {
   const std::vector<double>& importance_;
   const SelectionParams& params_;
   bool exact_ = false;
+  const std::vector<std::uint8_t>* free_ = nullptr;
+  const std::vector<std::uint8_t>* base_ = nullptr;
   std::vector<Col> group_col_, edge_col_;
   std::vector<Term> count_terms_;
   double count_constant_ = 0.0;
@@ -661,6 +717,38 @@ Index count_collapsed_clusters(const GroupConstraints& gc, const std::vector<std
   for (const auto& groups : gc.geo)
     n += std::all_of(groups.begin(), groups.end(), [&](Index grp) { return !y[grp]; });
   return n;
+}
+
+// Eq. 9 in group space — what the banded fast model evaluates to for the completion of y:
+// |N' − N| + λ_geo · (clusters with every group collapsed) − λ_edge · Σ Q̂ y.
+double group_objective(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                       const std::vector<std::uint8_t>& y, std::uint64_t target,
+                       const SelectionParams& params) {
+  std::uint64_t count = 0;
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f) count += face_count(fg, f, y);
+  double importance = 0.0;
+  for (Index grp = 0; grp < g.count; ++grp) importance += y[grp] * g.importance[grp];
+  return std::abs(double(count) - double(target)) +
+         params.lambda_geo * double(count_collapsed_clusters(gc, y)) - params.lambda_edge * importance;
+}
+
+// Groups that share a face, as CSR.
+void group_adjacency(const Groups& g, const FaceGroups& fg, std::vector<Index>& offsets,
+                     std::vector<Index>& adjacent) {
+  std::vector<std::vector<Index>> lists(g.count);
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f)
+    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i)
+      for (Index j = fg.offsets[f]; j < fg.offsets[f + 1]; ++j)
+        if (i != j) lists[fg.group[i]].push_back(fg.group[j]);
+  offsets.assign(std::size_t{g.count} + 1, 0);
+  adjacent.clear();
+  for (Index grp = 0; grp < g.count; ++grp) {
+    auto& l = lists[grp];
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+    adjacent.insert(adjacent.end(), l.begin(), l.end());
+    offsets[grp + 1] = static_cast<Index>(adjacent.size());
+  }
 }
 
 }  // namespace
@@ -708,6 +796,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     }
     Stopwatch solve_clock;
     ilp::SolveParams sp = params.solve;
+    sp.start_as_mip_start = params.greedy_as_mip_start;
     sp.time_limit_seconds = seconds;
     if (!params.quiet && !sp.on_progress)
       sp.on_progress = [](const ilp::Progress& p) {
@@ -724,6 +813,95 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     return x;
   };
 
+  // Large-neighbourhood search (SelectionParams::Strategy): BFS over groups that share a face
+  // collects `neighbourhood_groups` free groups around a seed; the fast model restricted to them
+  // (everything else fixed at the incumbent, the greedy selection as cutoff) is solved and an
+  // improvement is kept. Seeds sweep the groups in index order; a sweep without improvement ends
+  // the search.
+  auto neighbourhood_search = [&](std::vector<std::uint8_t> y, double seconds) {
+    Stopwatch lns_clock;
+    std::vector<Index> adj_offsets, adjacent;
+    group_adjacency(groups, fg, adj_offsets, adjacent);
+    double best = group_objective(groups, gc, fg, y, target, params);
+    std::vector<std::uint8_t> free(groups.count, 0), covered(groups.count, 0);
+    std::vector<Index> stamp(groups.count, kInvalidIndex), queue, freed;
+    Index cursor = 0, improved_in_sweep = 0;
+    ilp::SolveResult summary;
+    summary.backend = params.solver;
+    summary.call = ilp::CallStatus::Ok;
+    auto solver = ilp::make_solver(params.solver, &summary.message);
+    if (!solver) return y;
+    while (lns_clock.seconds() < seconds) {
+      // Next seed: the first group of this sweep not yet inside a neighbourhood.
+      while (cursor < groups.count && (covered[cursor] || groups.fixed[cursor])) ++cursor;
+      if (cursor == groups.count) {
+        ++result.neighbourhood_sweeps;
+        if (improved_in_sweep == 0) {
+          result.neighbourhoods_converged = true;
+          break;
+        }
+        improved_in_sweep = 0;
+        std::fill(covered.begin(), covered.end(), 0);
+        cursor = 0;
+        continue;
+      }
+      const Index round = result.neighbourhoods;
+      queue.assign(1, cursor);
+      stamp[cursor] = round;
+      freed.clear();
+      for (std::size_t head = 0; head < queue.size() && freed.size() < params.neighbourhood_groups; ++head) {
+        const Index a = queue[head];
+        if (!groups.fixed[a]) {
+          free[a] = covered[a] = 1;
+          freed.push_back(a);
+        }
+        for (Index k = adj_offsets[a]; k < adj_offsets[a + 1]; ++k)
+          if (stamp[adjacent[k]] != round) {
+            stamp[adjacent[k]] = round;
+            queue.push_back(adjacent[k]);
+          }
+      }
+      ModelBuilder sub(mesh, conn, analysis, groups, gc, fg, importance, params);
+      sub.set_scope(free, y);
+      sub.build(target, true);
+      sub.model.set_initial_solution(sub.complete(y, target));
+      ilp::SolveParams sp = params.solve;
+      sp.start_as_mip_start = params.greedy_as_mip_start;
+      sp.time_limit_seconds =
+          std::max(1e-3, std::min(params.neighbourhood_time_limit, seconds - lns_clock.seconds()));
+      const ilp::SolveResult r = solver->solve(sub.model, sp);
+      ++result.neighbourhoods;
+      summary.nodes += r.nodes;
+      summary.iterations += r.iterations;
+      if (r.has_solution() && !r.solution_is_start) {
+        std::vector<std::uint8_t> candidate = sub.group_bits(r.solution);
+        const double value = group_objective(groups, gc, fg, candidate, target, params);
+        if (value < best - 1e-9 * std::max(1.0, std::abs(best))) {
+          best = value;
+          y = std::move(candidate);
+          ++result.neighbourhoods_improved;
+          ++improved_in_sweep;
+          if (!params.quiet) {
+            std::fprintf(stderr, "\rselect      neighbourhood %u  objective %.4f  %6.1f s",
+                         result.neighbourhoods, best, lns_clock.seconds());
+            std::fflush(stderr);
+          }
+        }
+      }
+      for (Index a : freed) free[a] = 0;
+    }
+    if (!params.quiet && result.neighbourhoods_improved) std::fprintf(stderr, "\n");
+    summary.status = ilp::SolveStatus::Feasible;  // no bound: a neighbourhood optimum is not a global one
+    summary.objective = best;
+    summary.seconds = lns_clock.seconds();
+    summary.solution_is_start = result.neighbourhoods_improved == 0;
+    summary.start = ilp::StartStatus::NotUsed;
+    result.solve = std::move(summary);
+    result.solver_ran = true;
+    result.seconds_solve += lns_clock.seconds();
+    return y;
+  };
+
   Stopwatch build_clock;
   ModelBuilder banded(mesh, conn, analysis, groups, gc, fg, importance, params);
   banded.build(target, true);
@@ -735,9 +913,22 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
 
   std::vector<double> solution;
   const ModelBuilder* used = &banded;
+  const bool neighbourhoods =
+      params.formulation == Formulation::Fast &&
+      (params.strategy == SelectionParams::Strategy::Neighbourhoods ||
+       (params.strategy == SelectionParams::Strategy::Auto &&
+        result.model.size.rows > static_cast<std::int64_t>(params.whole_model_max_rows)));
+  result.strategy = time_limit > 0.0 ? (neighbourhoods ? "neighbourhoods" : "whole") : "greedy";
   if (reachable) {
     result.greedy_objective = banded.model.evaluate(banded_start);
-    solution = time_limit > 0.0 ? run(banded, time_limit) : banded_start;
+    // The budget covers the whole selection: what building the model and the greedy took is
+    // subtracted (at least 10 % of it is left to the solver).
+    const double budget = std::max(0.1 * time_limit, time_limit - clock.seconds());
+    if (time_limit > 0.0 && neighbourhoods) {
+      solution = banded.complete(neighbourhood_search(greedy.y, budget), target);
+    } else {
+      solution = time_limit > 0.0 ? run(banded, budget) : banded_start;
+    }
     if (solution.empty()) solution = banded_start;
     result.band_enforced = true;
   } else if (time_limit > 0.0) {
@@ -769,7 +960,6 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.note = "target " + std::to_string(target) + " is out of reach of the hard constraints: " +
                   "the closest selection found has " + std::to_string(result.predicted) +
                   " triangle-equivalents";
-  (void)clock;
   return result;
 }
 

@@ -53,10 +53,38 @@ struct SelectionParams {
   /// Edges with more than two faces cannot be collapsed safely (the collapse would join
   /// unrelated sheets), so their groups are fixed to "kept".
   bool keep_nonmanifold_edges = true;
+  /// Edges that must be kept, one entry per Connectivity edge (nonzero = keep); empty = none.
+  /// The pipeline pins here the edges whose collapse the reconstruction refused in an earlier
+  /// round (§3.3.2 guarantees), so the next selection collapses other chords instead. Pinning
+  /// an edge keeps its whole group (Eq. 4).
+  std::vector<std::uint8_t> keep_edges;
 
   /// The MIP solve. time_limit_seconds <= 0 skips the solver and returns the greedy selection.
   std::string solver = "cbc";
   ilp::SolveParams solve;
+  /// How the greedy selection reaches the solver. false (default): as a cutoff — the solver only
+  /// searches for better selections and the greedy one is the floor of the result. true: as a
+  /// MIP start. Measured on the corpus at ratio 0.4 with CBC 2.10.8 (Debian 12): a MIP start
+  /// crashed CBC inside CglPreProcess::postProcess on 8 of 30 meshes when the time limit cut the
+  /// search (e.g. godot_squash_player_cage, 5 s), and the helper's knapsack runs found weak starts
+  /// make CBC skip its feasibility pump; the cutoff gives the same floor without either problem.
+  bool greedy_as_mip_start = false;
+
+  /// How the solver's time is spent (beyond the paper; docs/formulation.md, "Speed").
+  ///   Whole:          one MIP over the whole model, the greedy selection as floor.
+  ///   Neighbourhoods: large-neighbourhood search — starting from the greedy selection, the MIP
+  ///                   restricted to `neighbourhood_groups` adjacent groups (everything else
+  ///                   fixed) is solved again and again over the mesh, keeping every
+  ///                   improvement, until a full sweep improves nothing or time runs out.
+  ///   Auto:           Whole when the fast model has at most `whole_model_max_rows` rows, else
+  ///                   Neighbourhoods (CBC's root LP alone outgrows a 5 s budget above that).
+  /// The exact formulation always solves the whole model (it is the paper's reference).
+  enum class Strategy { Auto, Whole, Neighbourhoods };
+  Strategy strategy = Strategy::Auto;
+  Index whole_model_max_rows = 20000;
+  Index neighbourhood_groups = 400;
+  /// Time limit of one neighbourhood MIP, seconds.
+  double neighbourhood_time_limit = 0.5;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
@@ -94,6 +122,11 @@ struct SelectionResult {
 
   bool solver_ran = false;
   ilp::SolveResult solve;               ///< statistics (solution vector dropped)
+  std::string strategy;                 ///< "whole", "neighbourhoods" or "greedy"
+  Index neighbourhoods = 0;             ///< neighbourhood MIPs solved
+  Index neighbourhoods_improved = 0;    ///< of those, how many improved the selection
+  Index neighbourhood_sweeps = 0;       ///< full passes over the groups
+  bool neighbourhoods_converged = false;  ///< a full sweep improved nothing
   SelectionModelStats model;
   double seconds_build = 0.0;
   double seconds_greedy = 0.0;

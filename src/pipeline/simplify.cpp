@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 
 namespace quadlod {
 
@@ -62,6 +63,11 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"band_enforced", s.band_enforced},
       {"note", s.note},
       {"solver_ran", s.solver_ran},
+      {"strategy", s.strategy},
+      {"neighbourhoods", s.neighbourhoods},
+      {"neighbourhoods_improved", s.neighbourhoods_improved},
+      {"neighbourhood_sweeps", s.neighbourhood_sweeps},
+      {"neighbourhoods_converged", s.neighbourhoods_converged},
       {"seconds_build", s.seconds_build},
       {"seconds_greedy", s.seconds_greedy},
       {"seconds_solve", s.seconds_solve},
@@ -126,7 +132,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   };
   log.done(1, "analysis", analysis_seconds, analysis_summary(input, analysis));
 
-  // 2. Target and edge selection (§3.2).
+  // 2. Target (§3.2, Eq. 2: triangle-equivalents).
   result.input_tri_equivalent = tri_equivalent_count(input);
   result.target = options.target_tri_equivalent > 0
                       ? options.target_tri_equivalent
@@ -139,56 +145,129 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   sp.consistency = options.consistency;
   sp.geometry = options.geometry;
   sp.solver = options.solver;
-  sp.solve.time_limit_seconds = options.time_limit_seconds;
   sp.solve.threads = options.threads;
   sp.solve.seed = options.seed;
   sp.quiet = !options.progress;
-  clock = Stopwatch();
-  const SelectionResult selection = select_edges(input, conn, analysis, result.target, sp);
-  const double select_seconds = clock.seconds();
-  report["selection"] = solve_json(selection);
-  report["selection"]["seconds"] = select_seconds;
-  if (!selection.note.empty()) result.note = selection.note;
-  log.done(2, "select", select_seconds,
-           "N' " + std::to_string(selection.predicted) + " of target " + std::to_string(result.target) +
-               (selection.solver_ran ? ", solver " + std::string(ilp::to_string(selection.solve.status)) : ""));
-
-  // 3. Dual-graph repair (§3.3.1).
-  clock = Stopwatch();
   DualRepairParams dp;
   dp.enable = options.dual_repair;
-  const DualRepairResult repaired = repair_dual_graph(input, conn, analysis.polychords, selection.edge_kept, dp);
-  report["dual_repair"] = {
-      {"seconds", repaired.seconds},
-      {"super_faces_found", repaired.stats.super_faces_found},
-      {"super_faces_left", repaired.stats.super_faces_left},
-      {"splits", repaired.stats.splits},
-      {"eroded_edges", repaired.stats.eroded_edges},
-      {"restored_edges", repaired.stats.restored_edges},
-      {"unsplittable", repaired.stats.unsplittable},
-      {"max_valence_before", repaired.stats.max_valence_before},
-      {"max_valence_after", repaired.stats.max_valence_after},
-  };
-  log.done(3, "dual", clock.seconds(),
-           std::to_string(repaired.stats.super_faces_found) + " super-faces, " +
-               std::to_string(repaired.stats.splits) + " splits");
-
-  // 4. Cluster collapse with QEM placement and guarantees (§3.3.2).
-  clock = Stopwatch();
   ClusterCollapseParams cp;
   cp.max_hausdorff = options.max_hausdorff;
-  ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, cp);
-  if (collapsed.status != ClusterCollapseStatus::Ok) {
-    result.error = collapsed.error;
-    return result;
+
+  // Stages 2–4 — selection (§3.2), dual repair (§3.3.1), cluster collapse (§3.3.2) — run in
+  // rounds (beyond the paper). The collapse refuses clusters that would break a guarantee, and
+  // every refusal keeps faces the selection meant to remove, so the output can land well above
+  // N. A further round pins the refused edges as kept (their chords are not collapsible here),
+  // aims the selection below N by the drift the last round showed, and runs the three stages
+  // again, until the result is within `round_tolerance` of N or `max_rounds` ran out. The round
+  // closest to N is the result.
+  const bool reducing = result.target < result.input_tri_equivalent;
+  const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
+  std::vector<std::uint8_t> pinned;
+  std::int64_t selection_target = static_cast<std::int64_t>(result.target);
+  std::optional<ClusterCollapseResult> best;
+  double best_distance = INFINITY;
+  Index best_refusals = 0;
+  double select_total = 0.0, dual_total = 0.0, collapse_total = 0.0;
+  nlohmann::json rounds = nlohmann::json::array();
+  for (int round = 1; round <= max_rounds; ++round) {
+    const std::string tag = round == 1 ? std::string() : " (round " + std::to_string(round) + ")";
+    sp.solve.time_limit_seconds =
+        round == 1 ? options.time_limit_seconds : options.time_limit_seconds * options.later_round_time_fraction;
+    sp.keep_edges = pinned;
+    clock = Stopwatch();
+    const SelectionResult selection =
+        select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
+    const double select_seconds = clock.seconds();
+    select_total += select_seconds;
+    log.done(2, "select", select_seconds,
+             "N' " + std::to_string(selection.predicted) + " of " + std::to_string(selection_target) +
+                 (selection.solver_ran ? ", solver " + std::string(ilp::to_string(selection.solve.status)) : "") +
+                 tag);
+
+    clock = Stopwatch();
+    const DualRepairResult repaired =
+        repair_dual_graph(input, conn, analysis.polychords, selection.edge_kept, dp);
+    dual_total += clock.seconds();
+    log.done(3, "dual", clock.seconds(),
+             std::to_string(repaired.stats.super_faces_found) + " super-faces, " +
+                 std::to_string(repaired.stats.splits) + " splits" + tag);
+
+    clock = Stopwatch();
+    ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, cp);
+    if (collapsed.status != ClusterCollapseStatus::Ok) {
+      result.error = collapsed.error;
+      return result;
+    }
+    collapse_total += clock.seconds();
+    const std::int64_t achieved = static_cast<std::int64_t>(collapsed.stats.tri_equivalent_out);
+    const std::int64_t drift = achieved - static_cast<std::int64_t>(result.target);
+    log.done(4, "collapse", clock.seconds(),
+             std::to_string(collapsed.stats.total_refusals()) + " clusters refused, " +
+                 std::to_string(achieved) + " of " + std::to_string(result.target) + tag);
+
+    // Edges the selection (after repair) collapsed and the collapse kept: refused.
+    Index newly_pinned = 0;
+    if (pinned.empty()) pinned.assign(conn.num_edges, 0);
+    for (Index e = 0; e < conn.num_edges; ++e)
+      if (!repaired.edge_kept[e] && !collapsed.edge_collapsed_final[e] && !pinned[e]) {
+        pinned[e] = 1;
+        ++newly_pinned;
+      }
+
+    nlohmann::json round_json = {
+        {"round", round},
+        {"selection_target", selection_target},
+        {"predicted", selection.predicted},
+        {"achieved", achieved},
+        {"refusals", collapsed.stats.total_refusals()},
+        {"refused_tri_equivalents",
+         std::int64_t(collapsed.stats.tri_equivalent_out) - std::int64_t(collapsed.stats.tri_equivalent_wanted)},
+        {"newly_pinned_edges", newly_pinned},
+        {"seconds_select", select_seconds},
+        {"time_limit_seconds", sp.solve.time_limit_seconds},
+    };
+    const double distance = std::abs(double(drift));
+    const bool better = distance < best_distance;
+    round_json["chosen"] = better;
+    if (better) {
+      for (auto& r : rounds) r["chosen"] = false;
+      best_distance = distance;
+      report["selection"] = solve_json(selection);
+      report["selection"]["seconds"] = select_seconds;
+      report["dual_repair"] = {
+          {"seconds", repaired.seconds},
+          {"super_faces_found", repaired.stats.super_faces_found},
+          {"super_faces_left", repaired.stats.super_faces_left},
+          {"splits", repaired.stats.splits},
+          {"eroded_edges", repaired.stats.eroded_edges},
+          {"restored_edges", repaired.stats.restored_edges},
+          {"unsplittable", repaired.stats.unsplittable},
+          {"max_valence_before", repaired.stats.max_valence_before},
+          {"max_valence_after", repaired.stats.max_valence_after},
+      };
+      report["collapse"] = to_json(collapsed.stats);
+      report["collapse"]["seconds"] = collapsed.seconds;
+      result.note = selection.note;
+      result.rounds_used = round;
+      best_refusals = collapsed.stats.total_refusals();
+      best = std::move(collapsed);
+    }
+    rounds.push_back(std::move(round_json));
+    if (!reducing || distance <= options.round_tolerance * double(result.target)) break;
+    // Nothing new to pin and the count is already over: the selection target alone moves.
+    const std::int64_t next = selection_target - drift;
+    if (next < 1 || (newly_pinned == 0 && next == selection_target)) break;
+    selection_target = next;
   }
-  report["collapse"] = to_json(collapsed.stats);
-  report["collapse"]["seconds"] = collapsed.seconds;
-  log.done(4, "collapse", clock.seconds(),
-           std::to_string(collapsed.stats.total_refusals()) + " clusters refused");
+  const int rounds_run = static_cast<int>(rounds.size());
+  report["rounds"] = std::move(rounds);
+  report["stage_seconds"] = {{"analysis", analysis_seconds},
+                             {"select", select_total},
+                             {"dual", dual_total},
+                             {"collapse", collapse_total}};
 
   // 5. Summary.
-  result.mesh = std::move(collapsed.mesh);
+  result.mesh = std::move(best->mesh);
   result.achieved = tri_equivalent_count(result.mesh);
   for (Index f = 0; f < result.mesh.num_faces(); ++f) {
     const Index k = result.mesh.face_size(f);
@@ -200,11 +279,11 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (result.note.empty() && std::abs(deviation) > options.epsilon_n && result.target < result.input_tri_equivalent) {
     char text[256];
     std::snprintf(text, sizeof text,
-                  "achieved %llu is %+.1f %% off the target %llu: the selection predicted %llu; the "
-                  "dual repair and the collapse's refusals changed the count",
+                  "achieved %llu is %+.1f %% off the target %llu after %d rounds: the collapse refused "
+                  "%u clusters (report: collapse.refused) whose collapse would break a guarantee",
                   static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
-                  static_cast<unsigned long long>(result.target),
-                  static_cast<unsigned long long>(selection.predicted));
+                  static_cast<unsigned long long>(result.target), rounds_run,
+                  static_cast<unsigned>(best_refusals));
     result.note = text;
   }
   report["input_tri_equivalent"] = result.input_tri_equivalent;
@@ -232,6 +311,9 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"geometry", options.geometry},
       {"dual_repair", options.dual_repair},
       {"max_hausdorff", options.max_hausdorff},
+      {"max_rounds", options.max_rounds},
+      {"round_tolerance", options.round_tolerance},
+      {"later_round_time_fraction", options.later_round_time_fraction},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved));
