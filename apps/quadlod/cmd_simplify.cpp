@@ -18,6 +18,7 @@ struct SimplifyCliOptions {
   std::uint64_t faces = 0;
   SimplifyOptions pipeline;
   std::string formulation = "fast";
+  std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
 };
 
@@ -44,6 +45,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Solver");
   sub->add_option("--formulation", opt->formulation, "fast, or exact (the paper's model as written)")
       ->check(CLI::IsMember({"fast", "exact"}))->capture_default_str()->group("Solver");
+  sub->add_option("--strategy", opt->strategy,
+                  "auto, whole (one MIP) or neighbourhoods (large-neighbourhood search); fast formulation only")
+      ->check(CLI::IsMember({"auto", "whole", "neighbourhoods"}))->capture_default_str()->group("Solver");
   sub->add_option("--epsilon-n", p.epsilon_n, "Eq. 2 slack on the target")
       ->check(CLI::Range(0.0, 0.5))->capture_default_str()->group("Paper parameters");
   sub->add_option("--epsilon-theta", p.epsilon_theta_deg, "Segmentation breakpoint angle, degrees (§3.2.2)")
@@ -83,6 +87,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
             p.exact_formulation = opt->formulation == "exact";
+            p.strategy = opt->strategy;
             p.consistency = !opt->no_consistency;
             p.segmentation = !opt->no_segmentation;
             p.geometry = !opt->no_geometry;

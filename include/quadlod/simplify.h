@@ -36,6 +36,8 @@ struct SimplifyOptions {
   int threads = 1;                  ///< solver threads; 0 = all cores
   std::uint32_t seed = 1;
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
+  /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).
+  std::string strategy = "auto";
   std::string solver = "cbc";
 
   // --- rounds (beyond the paper) ------------------------------------------------------------

@@ -61,9 +61,16 @@
 #include <climits>
 #include <cmath>
 #include <exception>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace quadlod::ilp {
 
@@ -337,6 +344,214 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   return out;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Process isolation (SolveParams::isolate_process). The child runs run_cbc and streams records
+// through a pipe: 'P' + 3 doubles for each progress event, 'R' + length + the RunOutcome.
+
+void write_all(int fd, const char* data, std::size_t n) {
+  while (n > 0) {
+    const ssize_t k = ::write(fd, data, n);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return;  // the parent is gone: nothing left to tell
+    data += k;
+    n -= static_cast<std::size_t>(k);
+  }
+}
+
+struct Packer {
+  std::string bytes;
+  template <class T>
+  void put(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void put_doubles(const std::vector<double>& v) {
+    put<std::uint64_t>(v.size());
+    bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
+  }
+  void put_string(const std::string& s) {
+    put<std::uint64_t>(s.size());
+    bytes.append(s);
+  }
+};
+
+struct Unpacker {
+  const char* p;
+  const char* end;
+  bool ok = true;
+  template <class T>
+  T get() {
+    T v{};
+    if (end - p < static_cast<std::ptrdiff_t>(sizeof v)) { ok = false; return v; }
+    std::memcpy(&v, p, sizeof v);
+    p += sizeof v;
+    return v;
+  }
+  std::vector<double> get_doubles() {
+    const auto n = get<std::uint64_t>();
+    if (!ok || static_cast<std::uint64_t>(end - p) / sizeof(double) < n) { ok = false; return {}; }
+    std::vector<double> v(n);
+    std::memcpy(v.data(), p, n * sizeof(double));
+    p += n * sizeof(double);
+    return v;
+  }
+  std::string get_string() {
+    const auto n = get<std::uint64_t>();
+    if (!ok || static_cast<std::uint64_t>(end - p) < n) { ok = false; return {}; }
+    std::string s(p, n);
+    p += n;
+    return s;
+  }
+};
+
+std::string pack(const RunOutcome& o) {
+  Packer w;
+  w.put<int>(static_cast<int>(o.status));
+  w.put_doubles(o.solution);
+  w.put(o.best_bound);
+  w.put(o.nodes);
+  w.put(o.iterations);
+  for (bool b : {o.reached_branch_and_bound, o.root_lp_infeasible, o.root_lp_stopped,
+                 o.incumbent_before_search, o.time_limit_reached})
+    w.put<std::uint8_t>(b);
+  for (std::int64_t v : {o.presolved.rows, o.presolved.cols, o.presolved.nonzeros, o.presolved.integer_cols})
+    w.put(v);
+  w.put_string(o.error);
+  return w.bytes;
+}
+
+bool unpack(const char* data, std::size_t n, RunOutcome& o) {
+  Unpacker r{data, data + n};
+  o.status = static_cast<SolveStatus>(r.get<int>());
+  o.solution = r.get_doubles();
+  o.best_bound = r.get<double>();
+  o.nodes = r.get<std::int64_t>();
+  o.iterations = r.get<std::int64_t>();
+  o.reached_branch_and_bound = r.get<std::uint8_t>();
+  o.root_lp_infeasible = r.get<std::uint8_t>();
+  o.root_lp_stopped = r.get<std::uint8_t>();
+  o.incumbent_before_search = r.get<std::uint8_t>();
+  o.time_limit_reached = r.get<std::uint8_t>();
+  o.presolved.rows = r.get<std::int64_t>();
+  o.presolved.cols = r.get<std::int64_t>();
+  o.presolved.nonzeros = r.get<std::int64_t>();
+  o.presolved.integer_cols = r.get<std::int64_t>();
+  o.error = r.get_string();
+  return r.ok && r.p == r.end;
+}
+
+// run_cbc in a child process. `incident` says what went wrong with the child, if anything.
+RunOutcome run_cbc_isolated(const Model& model, const CoinProblem& problem, const SolveParams& params,
+                            double time_limit, bool preprocess, bool use_start, double cutoff,
+                            RunContext& run, std::string& incident) {
+  int fds[2];
+  if (::pipe(fds) != 0) return run_cbc(model, problem, params, time_limit, preprocess, use_start, cutoff, run);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return run_cbc(model, problem, params, time_limit, preprocess, use_start, cutoff, run);
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    const int out = fds[1];
+    SolveParams child = params;
+    if (params.on_progress)
+      child.on_progress = [out](const Progress& p) {
+        Packer w;
+        w.put('P');
+        w.put(p.objective);
+        w.put(p.best_bound);
+        w.put(p.seconds);
+        write_all(out, w.bytes.data(), w.bytes.size());
+      };
+    run.params = &child;
+    const std::string result = pack(run_cbc(model, problem, child, time_limit, preprocess, use_start, cutoff, run));
+    Packer w;
+    w.put('R');
+    w.put<std::uint64_t>(result.size());
+    write_all(out, w.bytes.data(), w.bytes.size());
+    write_all(out, result.data(), result.size());
+    ::close(out);
+    ::_exit(0);  // no destructors, no atexit handlers of the parent's state
+  }
+  ::close(fds[1]);
+  const Clock::time_point start = Clock::now();
+  const double allowed = std::isfinite(time_limit) ? time_limit + std::max(2.0, 0.25 * time_limit) : kInf;
+  std::string buffer;
+  RunOutcome out;
+  bool have_result = false, killed = false;
+  char chunk[1 << 16];
+  for (;;) {
+    int wait_ms = -1;
+    if (std::isfinite(allowed)) {
+      const double left = allowed - seconds_since(start);
+      if (left <= 0) {
+        ::kill(pid, SIGKILL);
+        killed = true;
+        break;
+      }
+      wait_ms = static_cast<int>(std::ceil(left * 1000.0));
+    }
+    pollfd pfd{fds[0], POLLIN, 0};
+    const int ready = ::poll(&pfd, 1, wait_ms);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) continue;  // re-check the deadline
+    const ssize_t k = ::read(fds[0], chunk, sizeof chunk);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) break;  // EOF: the child is done (or died)
+    buffer.append(chunk, static_cast<std::size_t>(k));
+    // Consume complete records.
+    std::size_t pos = 0;
+    for (;;) {
+      if (buffer.size() - pos < 1) break;
+      const char tag = buffer[pos];
+      if (tag == 'P') {
+        constexpr std::size_t size = 1 + 3 * sizeof(double);
+        if (buffer.size() - pos < size) break;
+        Progress p{};
+        std::memcpy(&p.objective, buffer.data() + pos + 1, sizeof(double));
+        std::memcpy(&p.best_bound, buffer.data() + pos + 1 + sizeof(double), sizeof(double));
+        std::memcpy(&p.seconds, buffer.data() + pos + 1 + 2 * sizeof(double), sizeof(double));
+        pos += size;
+        if (params.on_progress) {
+          try {
+            params.on_progress(p);
+          } catch (...) {
+          }
+        }
+      } else if (tag == 'R') {
+        if (buffer.size() - pos < 1 + sizeof(std::uint64_t)) break;
+        std::uint64_t n = 0;
+        std::memcpy(&n, buffer.data() + pos + 1, sizeof n);
+        if (buffer.size() - pos < 1 + sizeof n + n) break;
+        have_result = unpack(buffer.data() + pos + 1 + sizeof n, n, out);
+        pos += 1 + sizeof n + n;
+      } else {
+        pos = buffer.size();  // garbage: drop it (cannot happen with our own child)
+      }
+    }
+    buffer.erase(0, pos);
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (have_result) return out;
+  out = RunOutcome{};
+  out.status = SolveStatus::NoSolution;
+  if (killed) {
+    incident = "CBC overran its time limit (" + arg(time_limit) + " s) and was stopped";
+    out.time_limit_reached = true;
+  } else if (WIFSIGNALED(status)) {
+    incident = std::string("CBC crashed (") + strsignal(WTERMSIG(status)) +
+               ") inside the solver library; the solve ran in a child process, so only it was lost";
+  } else {
+    incident = "the CBC child process ended without a result (exit status " +
+               std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+  }
+  return out;
+}
+
 class CbcBackend final : public Solver {
  public:
   std::string name() const override { return "cbc"; }
@@ -393,7 +608,13 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
   // The budget counts from entry into solve(): converting and loading a big model takes a
   // noticeable part of it (about 1 s for 1.45M nonzeros).
   const double budget = std::max(1e-3, params.time_limit_seconds - seconds_since(t0));
-  RunOutcome out = run_cbc(model, problem, params, budget, /*preprocess=*/true, use_start, cutoff, run);
+  std::string incident;
+  auto run_once = [&](double seconds, bool preprocess) {
+    return params.isolate_process
+               ? run_cbc_isolated(model, problem, params, seconds, preprocess, use_start, cutoff, run, incident)
+               : run_cbc(model, problem, params, seconds, preprocess, use_start, cutoff, run);
+  };
+  RunOutcome out = run_once(budget, /*preprocess=*/true);
   if (std::isfinite(cutoff) && out.status == SolveStatus::Infeasible && out.error.empty()) {
     // Nothing better than the start exists (search complete) or was found (time ran out).
     // Only a finished search or an infeasible root LP proves it; pre-processing cut short by the
@@ -416,7 +637,7 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
       out.status = SolveStatus::NoSolution;
     } else {
       const std::int64_t nodes = out.nodes, iterations = out.iterations;
-      out = run_cbc(model, problem, params, remaining, /*preprocess=*/false, use_start, cutoff, run);
+      out = run_once(remaining, /*preprocess=*/false);
       out.nodes += nodes;
       out.iterations += iterations;
       backend::note(result, CallStatus::Warning,
@@ -435,6 +656,7 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
                       " rows); CBC found no solution");
   }
   if (!out.error.empty()) backend::note(result, CallStatus::Error, out.error);
+  if (!incident.empty()) backend::note(result, CallStatus::Warning, incident);
   result.status = out.status;
   result.solution = std::move(out.solution);
   result.best_bound = out.best_bound;

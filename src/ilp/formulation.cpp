@@ -770,6 +770,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
 
   const std::vector<double> importance = edge_importance(mesh, conn, params.importance_cap);
   const Groups groups = make_groups(conn, analysis, importance, params);
+  for (double q : importance) result.baseline_objective -= params.lambda_edge * q;
   const GroupConstraints gc = make_group_constraints(groups, analysis, params);
   const FaceGroups fg = make_face_groups(mesh, conn, groups);
 

@@ -113,6 +113,10 @@ struct SelectionResult {
   std::uint64_t greedy_predicted = 0;   ///< N' of the greedy start
   double objective = 0.0;               ///< Eq. 9 value of the selection
   double greedy_objective = 0.0;        ///< Eq. 9 value of the greedy start
+  /// Eq. 9 without the count term when every edge is kept (−λ_edge Σ Q). objective − baseline
+  /// is the selection's cost above "keep everything", >= 0 up to the count term: the quantity to
+  /// compare relatively (the objective itself is offset by this constant).
+  double baseline_objective = 0.0;
   Index collapsed_groups = 0;
   Index collapsed_clusters = 0;         ///< Eq. 6 clusters with every edge collapsed
   bool band_enforced = false;           ///< Eq. 2 was a hard constraint (else unreachable)

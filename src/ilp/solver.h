@@ -56,6 +56,12 @@ struct SolveParams {
   /// greedy start, 1 s and 3 s solves ended 0.2-2.6 % worse with the start than without it in
   /// 12 of 12 runs. A good start (e.g. a previous solution) helps through its cutoff.
   bool start_as_mip_start = true;
+  /// Run the backend in a child process (POSIX fork; the CBC backend). A crash inside the solver
+  /// library — seen with Debian's CBC 2.10.8: SIGSEGV in CglPreProcess::postProcess, SIGABRT on
+  /// a Clp assertion — then ends only that child: the solve reports "no solution" with a warning
+  /// and the initial solution, if any, is the result. A child that overruns the time limit by
+  /// more than max(2 s, 25 %) is killed. Progress callbacks still run in the caller's process.
+  bool isolate_process = true;
   /// 0 = silent; >= 1 passes the level to the backend's own log (CBC: its log level, written
   /// to stdout by CBC itself).
   int log_level = 0;

@@ -10,6 +10,7 @@
 #include "topology/analysis.h"
 #include "util/progress.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -58,6 +59,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"greedy_predicted", s.greedy_predicted},
       {"objective", s.objective},
       {"greedy_objective", s.greedy_objective},
+      {"baseline_objective", s.baseline_objective},
       {"collapsed_groups", s.collapsed_groups},
       {"collapsed_clusters", s.collapsed_clusters},
       {"band_enforced", s.band_enforced},
@@ -142,6 +144,12 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
   if (options.lambda_edge >= 0.0) sp.lambda_edge = options.lambda_edge;
   sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
+  if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
+  else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
+  else if (options.strategy != "auto") {
+    result.error = "unknown solver strategy '" + options.strategy + "' (auto, whole, neighbourhoods)";
+    return result;
+  }
   sp.consistency = options.consistency;
   sp.geometry = options.geometry;
   sp.solver = options.solver;
@@ -159,11 +167,12 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   // N. A further round pins the refused edges as kept (their chords are not collapsible here),
   // aims the selection below N by the drift the last round showed, and runs the three stages
   // again, until the result is within `round_tolerance` of N or `max_rounds` ran out. The round
-  // closest to N is the result.
+  // closest to N is the result. docs/formulation.md ("Rounds") has the measurements.
   const bool reducing = result.target < result.input_tri_equivalent;
   const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
   std::vector<std::uint8_t> pinned;
   std::int64_t selection_target = static_cast<std::int64_t>(result.target);
+  std::int64_t previous_target = 0, previous_achieved = 0;
   std::optional<ClusterCollapseResult> best;
   double best_distance = INFINITY;
   Index best_refusals = 0;
@@ -254,8 +263,17 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     }
     rounds.push_back(std::move(round_json));
     if (!reducing || distance <= options.round_tolerance * double(result.target)) break;
-    // Nothing new to pin and the count is already over: the selection target alone moves.
-    const std::int64_t next = selection_target - drift;
+    // Re-aim: a secant step on achieved(selection target) through the last two rounds, its
+    // slope kept in [0.5, 1] (refusals make the output move less than the selection, and pins
+    // change the function between rounds), the target kept within [N/2, 3N/2].
+    double slope = 1.0;
+    if (round > 1 && selection_target != previous_target)
+      slope = std::clamp(double(achieved - previous_achieved) / double(selection_target - previous_target), 0.5, 1.0);
+    previous_target = selection_target;
+    previous_achieved = achieved;
+    const double aimed = double(selection_target) - double(drift) / slope;
+    const std::int64_t next = static_cast<std::int64_t>(std::llround(
+        std::clamp(aimed, 0.5 * double(result.target), 1.5 * double(result.target))));
     if (next < 1 || (newly_pinned == 0 && next == selection_target)) break;
     selection_target = next;
   }
@@ -306,6 +324,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"threads", options.threads},
       {"seed", options.seed},
       {"formulation", options.exact_formulation ? "exact" : "fast"},
+      {"strategy", options.strategy},
       {"consistency", options.consistency},
       {"segmentation", options.segmentation},
       {"geometry", options.geometry},
