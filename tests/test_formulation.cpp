@@ -37,6 +37,13 @@ double eq9(const Prepared& p, const std::vector<std::uint8_t>& kept, std::uint64
     value += all ? sp.lambda_geo : 0.0;
   }
   for (Index e = 0; e < p.conn.num_edges; ++e) value -= sp.lambda_edge * q[e] * kept[e];
+  // λ_tri: quads whose opposite edges are decided apart.
+  for (Index f = 0; f < p.mesh.num_faces(); ++f) {
+    if (p.mesh.face_size(f) != 4) continue;
+    const Index b = p.mesh.face_begin(f);
+    for (Index k = 0; k < 2; ++k)
+      if (kept[p.conn.corner_edge[b + k]] != kept[p.conn.corner_edge[b + k + 2]]) value += sp.lambda_tri;
+  }
   return value;
 }
 

@@ -56,6 +56,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_geo()))->group("Paper parameters");
   sub->add_option("--lambda-edge", p.lambda_edge, "Eq. 9 weight of edge importance")
       ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_edge()))->group("Paper parameters");
+  sub->add_option("--lambda-tri", p.lambda_tri,
+                  "Cost of a quad turned into a triangle (beyond the paper; 0 = the paper's Eq. 9)")
+      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_tri()))->group("Paper parameters");
   sub->add_option("--max-hausdorff", p.max_hausdorff, "Bound on moved vertices' distance, relative to the bbox diagonal (0 = off)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group("Guarantees");
   sub->add_option("--max-rounds", p.max_rounds,

@@ -30,6 +30,9 @@ struct SimplifyOptions {
   double epsilon_theta_deg = 60.0;  ///< §3.2.2 breakpoint angle (π/3)
   double lambda_geo = -1.0;         ///< Eq. 9; < 0 = the measured default (docs/parameters.md)
   double lambda_edge = -1.0;        ///< Eq. 9; < 0 = the measured default
+  /// Beyond the paper: cost of a quad turned into a triangle by a one-sided collapse;
+  /// < 0 = the measured default, 0 = the paper's objective.
+  double lambda_tri = -1.0;
 
   // --- solver -----------------------------------------------------------------------------------
   double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only
@@ -86,5 +89,6 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options);
 /// The measured defaults of λ_geo and λ_edge (see docs/parameters.md).
 double default_lambda_geo();
 double default_lambda_edge();
+double default_lambda_tri();
 
 }  // namespace quadlod

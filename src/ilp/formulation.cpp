@@ -78,6 +78,18 @@ std::uint64_t predicted_tri_equivalent(const PolyMesh& mesh, const Connectivity&
   return n;
 }
 
+std::uint64_t predicted_new_triangles(const PolyMesh& mesh, const Connectivity& conn,
+                                      const std::vector<std::uint8_t>& edge_kept) {
+  std::uint64_t n = 0;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    if (mesh.face_size(f) != 4) continue;
+    Index kept = 0;
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) kept += edge_kept[conn.corner_edge[c]];
+    n += kept == 3;
+  }
+  return n;
+}
+
 namespace {
 
 // ------------------------------------------------------------------------------------------
@@ -139,13 +151,36 @@ struct GroupConstraints {
   std::vector<std::vector<Index>> tri;  // per Eq. 7 cluster: its groups
   std::vector<std::pair<Index, Index>> tri_neighbours;
   std::vector<std::vector<Index>> group_geo, group_tri;  // inverse lists
+  // λ_tri term: opposite edges of a quad in different groups (one pair per quad side pair);
+  // group_split lists, per group, the partner group of each such pair it is in.
+  std::vector<std::pair<Index, Index>> split_pairs;
+  std::vector<std::vector<Index>> group_split;
 };
 
-GroupConstraints make_group_constraints(const Groups& g, const AnalysisResult& analysis,
-                                        const SelectionParams& params) {
+// Opposite edges (corners c and c + 2) of every quad, as edge pairs.
+template <class F>
+void for_each_opposite_pair(const PolyMesh& mesh, const Connectivity& conn, F&& f) {
+  for (Index face = 0; face < mesh.num_faces(); ++face) {
+    if (mesh.face_size(face) != 4) continue;
+    const Index b = mesh.face_begin(face);
+    for (Index k = 0; k < 2; ++k) f(conn.corner_edge[b + k], conn.corner_edge[b + k + 2]);
+  }
+}
+
+GroupConstraints make_group_constraints(const PolyMesh& mesh, const Connectivity& conn, const Groups& g,
+                                        const AnalysisResult& analysis, const SelectionParams& params) {
   GroupConstraints c;
   c.group_geo.resize(g.count);
   c.group_tri.resize(g.count);
+  c.group_split.resize(g.count);
+  if (params.lambda_tri > 0.0)
+    for_each_opposite_pair(mesh, conn, [&](Index e, Index f) {
+      const Index a = g.edge_group[e], b = g.edge_group[f];
+      if (a == b || (g.fixed[a] && g.fixed[b])) return;
+      c.split_pairs.emplace_back(a, b);
+      c.group_split[a].push_back(b);
+      c.group_split[b].push_back(a);
+    });
   if (!params.geometry) return c;
   for (const EdgeCluster& cluster : analysis.medial.clusters) {
     auto groups = distinct_groups(g, cluster.edges);
@@ -243,6 +278,8 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
     double c = params.lambda_edge * g.importance[grp];
     for (Index cl : gc.group_geo[grp])
       if (geo_kept[cl] == 1) c += params.lambda_geo;
+    // Collapsing grp splits pairs whose partner is kept and mends those whose partner is gone.
+    for (Index partner : gc.group_split[grp]) c += r.y[partner] ? params.lambda_tri : -params.lambda_tri;
     return c;
   };
   auto allowed = [&](Index grp) {
@@ -298,6 +335,8 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
     }
     r.y[top.group] = 0;
     r.count -= static_cast<std::uint64_t>(d);
+    for (Index partner : gc.group_split[top.group])  // their λ_tri cost just dropped
+      if (r.y[partner] && !g.fixed[partner]) push(partner);
     for (Index cl : gc.group_geo[top.group]) --geo_kept[cl];
     for (Index cl : gc.group_tri[top.group]) ++tri_collapsed[cl];
   }
@@ -337,6 +376,7 @@ class ModelBuilder {
     else build_fast_vars();
     build_faces();
     build_count(target, band);
+    if (params_.lambda_tri > 0.0) build_split_pairs();
     if (params_.geometry) {
       build_geo_clusters();
       build_tri_clusters();
@@ -370,6 +410,7 @@ class ModelBuilder {
     const double diff = count - double(target);
     x[p_] = std::max(0.0, diff);
     x[q_] = std::max(0.0, -diff);
+    for (const SplitPair& sp : split_) x[sp.d] = std::abs(x[sp.a] - x[sp.b]);
     for (const GeoCluster& c : geo_) {
       bool all_collapsed = true;
       for (Col col : c.cols) all_collapsed &= x[col] < 0.5;
@@ -416,6 +457,9 @@ class ModelBuilder {
   struct GeoCluster {
     Col var;
     std::vector<Col> cols;
+  };
+  struct SplitPair {
+    Col d, a, b;
   };
   struct TriCluster {
     Col var;
@@ -594,6 +638,28 @@ class ModelBuilder {
     model.add_eq(row, n - count_constant_);
   }
 
+  // λ_tri term (beyond the paper): d ≥ |x_a − x_b| for opposite quad edges decided apart (only
+  // the binding side: d is minimised). Exact: per edge pair across a segment boundary; fast: per
+  // group pair (a quad side pair whose edges lie in two groups).
+  void add_split(Col a, Col b) {
+    const Col d = model.add_continuous(0.0, 1.0, params_.lambda_tri);
+    model.add_ge({{d, 1.0}, {a, -1.0}, {b, 1.0}}, 0.0);
+    model.add_ge({{d, 1.0}, {a, 1.0}, {b, -1.0}}, 0.0);
+    split_.push_back({d, a, b});
+  }
+  void build_split_pairs() {
+    if (exact_) {
+      for_each_opposite_pair(mesh_, conn_, [&](Index e, Index f) {
+        const Index a = g_.edge_group[e], b = g_.edge_group[f];
+        if (a != b && !(g_.fixed[a] && g_.fixed[b])) add_split(edge_col_[e], edge_col_[f]);
+      });
+    } else {
+      for (const auto& [a, b] : gc_.split_pairs)
+        if (!free_ || (*free_)[a] || (*free_)[b]) add_split(group_col_[a], group_col_[b]);
+    }
+    stats.split_pairs = static_cast<Index>(split_.size());
+  }
+
   // Eq. 6: x_C = 1 iff every edge of cluster C is collapsed; λ_geo x_C in the objective.
   void build_geo_clusters() {
     if (exact_) {
@@ -708,6 +774,7 @@ class ModelBuilder {
   std::vector<Aggregate> aggregates_;
   std::vector<GeneralFace> general_;
   std::vector<GeoCluster> geo_;
+  std::vector<SplitPair> split_;
   std::vector<TriCluster> tri_;
   Col p_ = kNone, q_ = kNone;
 };
@@ -728,8 +795,10 @@ double group_objective(const Groups& g, const GroupConstraints& gc, const FaceGr
   for (Index f = 0; f + 1 < fg.offsets.size(); ++f) count += face_count(fg, f, y);
   double importance = 0.0;
   for (Index grp = 0; grp < g.count; ++grp) importance += y[grp] * g.importance[grp];
-  return std::abs(double(count) - double(target)) +
-         params.lambda_geo * double(count_collapsed_clusters(gc, y)) - params.lambda_edge * importance;
+  double split = 0.0;
+  for (const auto& [a, b] : gc.split_pairs) split += y[a] != y[b];
+  return std::abs(double(count) - double(target)) + params.lambda_geo * double(count_collapsed_clusters(gc, y)) -
+         params.lambda_edge * importance + params.lambda_tri * split;
 }
 
 // Groups that share a face, as CSR.
@@ -771,7 +840,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   const std::vector<double> importance = edge_importance(mesh, conn, params.importance_cap);
   const Groups groups = make_groups(conn, analysis, importance, params);
   for (double q : importance) result.baseline_objective -= params.lambda_edge * q;
-  const GroupConstraints gc = make_group_constraints(groups, analysis, params);
+  const GroupConstraints gc = make_group_constraints(mesh, conn, groups, analysis, params);
   const FaceGroups fg = make_face_groups(mesh, conn, groups);
 
   Stopwatch greedy_clock;

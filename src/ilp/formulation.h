@@ -41,6 +41,11 @@ struct SelectionParams {
   /// quadric collapse cost divided by the mean over all edges (so 1 = an average edge).
   /// Default chosen by measurement (docs/parameters.md).
   double lambda_edge = 0.05;
+  /// λ_tri (beyond the paper): cost of each quad whose two opposite edges are decided apart —
+  /// one collapsed, one kept — which turns the quad into a triangle. Such pairs exist only
+  /// across segment breakpoints (§3.2.2) and without Eq. 4. In triangle-equivalents, like the
+  /// count term. 0 = the paper's objective. Default chosen by measurement (docs/parameters.md).
+  double lambda_tri = 4.0;
   /// Importance values are capped at this multiple of the mean, so a few huge quadrics (long
   /// edges at sharp corners) cannot dominate the count term.
   double importance_cap = 20.0;
@@ -99,6 +104,7 @@ struct SelectionModelStats {
   Index geo_clusters = 0;        ///< Eq. 6 clusters in the model
   Index tri_clusters = 0;        ///< Eq. 7 clusters
   Index tri_neighbour_rows = 0;  ///< Eq. 8 rows
+  Index split_pairs = 0;         ///< λ_tri terms (opposite quad edges in different units)
   ilp::ModelSize size;
 };
 
@@ -153,5 +159,10 @@ std::vector<double> edge_importance(const PolyMesh& mesh, const Connectivity& co
 /// the ILP optimises; the mesh produced by the collapse may differ slightly (see §3.3).
 std::uint64_t predicted_tri_equivalent(const PolyMesh& mesh, const Connectivity& conn,
                                        const std::vector<std::uint8_t>& edge_kept);
+
+/// Quads with exactly three kept edges under a selection: the triangles it creates (for
+/// reports; the collapse may still refuse some of them).
+std::uint64_t predicted_new_triangles(const PolyMesh& mesh, const Connectivity& conn,
+                                      const std::vector<std::uint8_t>& edge_kept);
 
 }  // namespace quadlod

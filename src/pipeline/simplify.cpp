@@ -20,6 +20,7 @@ namespace quadlod {
 
 double default_lambda_geo() { return SelectionParams{}.lambda_geo; }
 double default_lambda_edge() { return SelectionParams{}.lambda_edge; }
+double default_lambda_tri() { return SelectionParams{}.lambda_tri; }
 
 namespace {
 
@@ -54,6 +55,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"geo_clusters", s.model.geo_clusters},
       {"tri_clusters", s.model.tri_clusters},
       {"tri_neighbour_rows", s.model.tri_neighbour_rows},
+      {"split_pairs", s.model.split_pairs},
       {"target", s.target},
       {"predicted", s.predicted},
       {"greedy_predicted", s.greedy_predicted},
@@ -143,6 +145,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   sp.epsilon_n = options.epsilon_n;
   if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
   if (options.lambda_edge >= 0.0) sp.lambda_edge = options.lambda_edge;
+  if (options.lambda_tri >= 0.0) sp.lambda_tri = options.lambda_tri;
   sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
   if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
   else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
@@ -243,6 +246,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       best_distance = distance;
       report["selection"] = solve_json(selection);
       report["selection"]["seconds"] = select_seconds;
+      report["selection"]["quads_to_triangles"] = predicted_new_triangles(input, conn, selection.edge_kept);
       report["dual_repair"] = {
           {"seconds", repaired.seconds},
           {"super_faces_found", repaired.stats.super_faces_found},
@@ -253,6 +257,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
           {"unsplittable", repaired.stats.unsplittable},
           {"max_valence_before", repaired.stats.max_valence_before},
           {"max_valence_after", repaired.stats.max_valence_after},
+          {"quads_to_triangles", predicted_new_triangles(input, conn, repaired.edge_kept)},
       };
       report["collapse"] = to_json(collapsed.stats);
       report["collapse"]["seconds"] = collapsed.seconds;
@@ -320,6 +325,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"epsilon_theta_deg", options.epsilon_theta_deg},
       {"lambda_geo", sp.lambda_geo},
       {"lambda_edge", sp.lambda_edge},
+      {"lambda_tri", sp.lambda_tri},
       {"time_limit_seconds", options.time_limit_seconds},
       {"threads", options.threads},
       {"seed", options.seed},
