@@ -1,0 +1,183 @@
+// quadlod::simplify end to end (paper Fig. 2): generated meshes with known answers and corpus
+// meshes against the output guarantees (issue: post-processing and `quadlod simplify`).
+#include "mesh/connectivity.h"
+#include "mesh/validation.h"
+#include "quadlod/generators.h"
+#include "quadlod/io.h"
+#include "quadlod/simplify.h"
+#include "topology/polychords.h"
+
+#include "cli_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace quadlod {
+namespace {
+
+MeshStats stats_of(const PolyMesh& mesh) { return compute_stats(mesh, build_connectivity(mesh)); }
+
+// The output guarantees of §3.3 (docs/cluster_collapse.md) that can be read off the output alone.
+void expect_valid(const PolyMesh& in, const PolyMesh& out, const std::string& what) {
+  const MeshStats a = stats_of(in), b = stats_of(out);
+  EXPECT_LE(b.nonmanifold_edges, a.nonmanifold_edges) << what;
+  EXPECT_LE(b.degenerate_faces, a.degenerate_faces) << what;
+  EXPECT_LE(b.duplicate_faces, a.duplicate_faces) << what;
+  EXPECT_EQ(b.nonfinite_vertices, 0u) << what;
+  EXPECT_EQ(b.unused_vertices, 0u) << what;
+}
+
+SimplifyOptions quick(double ratio) {
+  SimplifyOptions o;
+  o.ratio = ratio;
+  o.time_limit_seconds = 1.0;
+  return o;
+}
+
+TEST(Simplify, RegularGridAtHalfLosesWholeChordsAndStaysAllQuads) {
+  const PolyMesh grid = make_grid(8, 8, 1.0, 1.0);
+  const SimplifyResult r = simplify(grid, quick(0.5));
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.target, 64u);
+  EXPECT_NEAR(double(r.achieved), 64.0, 0.03 * 64.0);
+  EXPECT_EQ(r.triangles, 0u);
+  EXPECT_EQ(r.ngons, 0u);
+  expect_valid(grid, r.mesh, "grid");
+  // Whole chords went: the result is again a regular a×b grid (every interior vertex has four
+  // quads), with a·b = quads and (a + b) open chords instead of 16.
+  const Connectivity conn = build_connectivity(r.mesh);
+  const PolyChordResult chords = extract_polychords(r.mesh, conn);
+  Index a_plus_b = 0;
+  for (const PolyChord& c : chords.chords) a_plus_b += c.closed ? 0 : 1;
+  EXPECT_LT(a_plus_b, 16u);
+  bool found = false;
+  for (Index a = 1; a <= 8; ++a)
+    if (r.quads % a == 0 && a + r.quads / a == a_plus_b) found = true;
+  EXPECT_TRUE(found) << r.quads << " quads, " << a_plus_b << " chords";
+  // Geometry: a flat square stays the same flat square.
+  const MeshStats s = stats_of(r.mesh);
+  EXPECT_NEAR(s.bbox.min.x(), 0.0, 1e-9);
+  EXPECT_NEAR(s.bbox.max.x(), 1.0, 1e-9);
+  EXPECT_NEAR(s.bbox.max.z() - s.bbox.min.z(), 0.0, 1e-9);
+  EXPECT_EQ(s.boundary_loops, 1u);
+}
+
+TEST(Simplify, CubeStaysAValidClosedMesh) {
+  const PolyMesh cube = make_cube(4, 1.0);
+  for (double ratio : {0.8, 0.5, 0.3}) {
+    const SimplifyResult r = simplify(cube, quick(ratio));
+    ASSERT_TRUE(r.ok()) << r.error;
+    const MeshStats s = stats_of(r.mesh);
+    EXPECT_EQ(s.boundary_edges, 0u) << ratio;
+    EXPECT_EQ(s.nonmanifold_edges, 0u) << ratio;
+    EXPECT_EQ(s.nonmanifold_vertices, 0u) << ratio;
+    EXPECT_EQ(s.components, 1u) << ratio;
+    expect_valid(cube, r.mesh, "cube " + std::to_string(ratio));
+    // Within the band, or the miss is explained.
+    const double dev = std::abs(double(r.achieved) - double(r.target)) / double(r.target);
+    if (dev > 0.03) EXPECT_FALSE(r.note.empty()) << ratio;
+    // Euler characteristic of a sphere.
+    const Connectivity conn = build_connectivity(r.mesh);
+    EXPECT_EQ(std::int64_t(r.mesh.num_vertices()) - std::int64_t(conn.num_edges) + std::int64_t(r.mesh.num_faces()), 2)
+        << ratio;
+  }
+}
+
+TEST(Simplify, NothingToDoAtFullSize) {
+  const PolyMesh torus = make_torus(12, 8);
+  const SimplifyResult r = simplify(torus, quick(1.0));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.achieved, r.input_tri_equivalent);
+  EXPECT_NE(r.note.find("nothing to do"), std::string::npos) << r.note;
+  EXPECT_EQ(r.mesh.num_faces(), torus.num_faces());
+}
+
+TEST(Simplify, BadInputIsAnErrorNotACrash) {
+  PolyMesh torus = make_torus(6, 4);
+  torus.positions[3].x() = std::nan("");
+  const SimplifyResult r = simplify(torus, quick(0.5));
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.error.find("vertex"), std::string::npos) << r.error;
+}
+
+TEST(Simplify, ReportHasStagesRoundsAndSolverStatistics) {
+  const SimplifyResult r = simplify(make_demo_vase(24, 16), quick(0.5));
+  ASSERT_TRUE(r.ok()) << r.error;
+  const auto& rep = r.report;
+  for (const char* key : {"analysis", "selection", "dual_repair", "collapse", "rounds", "stage_seconds",
+                          "target", "achieved", "options"})
+    EXPECT_TRUE(rep.contains(key)) << key;
+  ASSERT_GE(rep["rounds"].size(), 1u);
+  int chosen = 0;
+  for (const auto& round : rep["rounds"]) chosen += round["chosen"].get<bool>();
+  EXPECT_EQ(chosen, 1);
+  EXPECT_EQ(rep["achieved"].get<std::uint64_t>(), r.achieved);
+  EXPECT_TRUE(rep["selection"].contains("formulation_rows"));
+  EXPECT_TRUE(rep["selection"]["solver"].contains("status"));
+}
+
+TEST(Simplify, RoundsPinRefusedCollapsesAndReAim) {
+  // The best round is the result, so allowing more rounds never moves the output away from
+  // the target; with one round the report lists exactly one.
+  const PolyMesh cube = make_cube(4, 1.0);
+  SimplifyOptions one = quick(0.3);
+  one.max_rounds = 1;
+  SimplifyOptions four = quick(0.3);
+  const SimplifyResult a = simplify(cube, one), b = simplify(cube, four);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const double dev_a = std::abs(double(a.achieved) - double(a.target));
+  const double dev_b = std::abs(double(b.achieved) - double(b.target));
+  EXPECT_LE(dev_b, dev_a);  // the best round is kept, so more rounds never do worse
+  EXPECT_EQ(a.report["rounds"].size(), 1u);
+}
+
+TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {
+  using namespace quadlod::testing;
+  const auto dir = scratch_dir("simplify-cli");
+  const auto in = dir / "vase.obj";
+  ASSERT_EQ(run_cli("-q generate vase -o '" + in.string() + "'", dir).exit_code, 0);
+  const std::string before = slurp(in);
+  const CliRun ok = run_cli("-q simplify '" + in.string() + "' -o '" + (dir / "out.obj").string() +
+                                "' --ratio 0.5 --time-limit 1 --report '" + (dir / "r.json").string() + "'",
+                            dir);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("simplify: target"), std::string::npos) << ok.out;
+  const auto report = nlohmann::json::parse(slurp(dir / "r.json"));
+  EXPECT_TRUE(report.contains("stage_seconds"));
+  const ReadResult out = read_mesh(dir / "out.obj");
+  ASSERT_TRUE(out.ok()) << out.error;
+  EXPECT_EQ(report["achieved"].get<std::uint64_t>(), tri_equivalent_count(out.mesh));
+  EXPECT_TRUE(out.mesh.has_uvs());  // the vase's UVs reach the output
+  // The output path naming the input is refused, and the input is untouched.
+  const CliRun same = run_cli("-q simplify '" + in.string() + "' -o '" + in.string() + "' --ratio 0.5", dir);
+  EXPECT_EQ(same.exit_code, 2);
+  EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
+  EXPECT_EQ(slurp(in), before);
+  // No target is a usage error.
+  EXPECT_EQ(run_cli("-q simplify '" + in.string() + "' -o '" + (dir / "x.obj").string() + "'", dir).exit_code, 1);
+  std::filesystem::remove_all(dir);
+}
+
+#ifdef QUADLOD_CORPUS_DIR
+TEST(SimplifyCorpus, SmallCorpusMeshesAreValidAndOnTarget) {
+  const std::filesystem::path dir = QUADLOD_CORPUS_DIR;
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not present";
+  for (const char* name : {"opensubdiv_bishop_cage.obj", "blender_suzanne.obj", "yofrankie_ram.obj"}) {
+    const ReadResult in = read_mesh(dir / name);
+    ASSERT_TRUE(in.ok()) << in.error;
+    for (double ratio : {0.6, 0.3}) {
+      const SimplifyResult r = simplify(in.mesh, quick(ratio));
+      ASSERT_TRUE(r.ok()) << name << ": " << r.error;
+      expect_valid(in.mesh, r.mesh, std::string(name) + " " + std::to_string(ratio));
+      const double dev = std::abs(double(r.achieved) - double(r.target)) / double(r.target);
+      if (dev > 0.03) EXPECT_FALSE(r.note.empty()) << name << " " << ratio;
+      EXPECT_GT(r.quads, 0u) << name;
+    }
+  }
+}
+#endif
+
+}  // namespace
+}  // namespace quadlod
