@@ -983,11 +983,11 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
 
   std::vector<double> solution;
   const ModelBuilder* used = &banded;
+  const auto free_groups = static_cast<Index>(std::count(groups.fixed.begin(), groups.fixed.end(), 0));
   const bool neighbourhoods =
       params.formulation == Formulation::Fast &&
       (params.strategy == SelectionParams::Strategy::Neighbourhoods ||
-       (params.strategy == SelectionParams::Strategy::Auto &&
-        result.model.size.rows > static_cast<std::int64_t>(params.whole_model_max_rows)));
+       (params.strategy == SelectionParams::Strategy::Auto && free_groups > params.neighbourhood_groups));
   result.strategy = time_limit > 0.0 ? (neighbourhoods ? "neighbourhoods" : "whole") : "greedy";
   if (reachable) {
     result.greedy_objective = banded.model.evaluate(banded_start);
