@@ -648,7 +648,7 @@ class Bench:
                    nonmanifold_vertices=val.get("nonmanifold_vertices"),
                    degenerate_faces=val.get("degenerate_faces"),
                    duplicate_faces=val.get("duplicate_faces"),
-                   flipped_faces=val.get("flipped_faces", val.get("flipped")),
+                   flipped_faces=ev.get("flipped_faces", val.get("flipped_faces")),
                    boundary_edges=val.get("boundary_edges"), components=val.get("components"),
                    flow_deviation_deg=ev.get("flow_deviation_deg"),
                    flow_deviation_p90_deg=ev.get("flow_deviation_p90_deg"),
@@ -976,7 +976,7 @@ def validity_section(rows):
             bad.append((r, probs))
     out = ["## Validity: outputs worse than their input\n"]
     out.append("Outputs with new non-manifold edges, or more degenerate or duplicate faces than the "
-               "input (flipped faces are not measured by `quadlod eval` yet).\n")
+               "input, or faces flipped against the input surface (`flipped_faces`, docs/metrics.md §6b).\n")
     if bad:
         out.append("| mesh | ratio | method | problems |")
         out.append("|---|---:|---|---|")

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -203,6 +205,21 @@ TEST(EvalMetrics, MeshAgainstItselfIsPerfect) {
   EXPECT_EQ(r.flow_deviation_p90_deg, 0.0);
   EXPECT_EQ(r.flow_coverage, 1.0);
   EXPECT_EQ(r.qpr_rule, "input_tri_free");
+  EXPECT_EQ(r.flipped_faces, 0u);
+}
+
+TEST(EvalMetrics, ReversedFacesAreCountedAsFlipped) {
+  const PolyMesh torus = make_torus(24, 12);
+  PolyMesh reversed = torus;
+  // Reverse the corner order of every other face.
+  std::uint64_t expected = 0;
+  for (Index f = 0; f < reversed.num_faces(); f += 2) {
+    std::reverse(reversed.corner_vertex.begin() + reversed.face_begin(f),
+                 reversed.corner_vertex.begin() + reversed.face_end(f));
+    ++expected;
+  }
+  EXPECT_EQ(evaluate(torus, reversed, small_params()).flipped_faces, expected);
+  EXPECT_EQ(evaluate(torus, torus, small_params()).flipped_faces, 0u);
 }
 
 // ∫₀¹∫₀¹ sqrt(1 + s² + t²) ds dt: inner integral in closed form, outer by composite Simpson.

@@ -88,9 +88,11 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
             std::printf("  hausdorff           %.4e\n", num(r.hausdorff));
             std::printf("  flow deviation      %.2f deg mean, %.2f deg p90, coverage %.3f\n",
                         num(r.flow_deviation_deg), num(r.flow_deviation_p90_deg), num(r.flow_coverage));
-            std::printf("  output validity     %u non-manifold edges (input %u), %u degenerate, %u duplicate faces\n",
+            std::printf("  output validity     %u non-manifold edges (input %u), %u degenerate, %u duplicate, "
+                        "%llu flipped faces\n",
                         validity.nonmanifold_edges, input_validity.nonmanifold_edges,
-                        validity.degenerate_faces, validity.duplicate_faces);
+                        validity.degenerate_faces, validity.duplicate_faces,
+                        static_cast<unsigned long long>(r.flipped_faces));
             return kExitOk;
           }};
 }

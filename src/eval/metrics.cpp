@@ -388,6 +388,28 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
   r.hausdorff = std::max(d_in.max, d_out.max);
   r.seconds_distance = seconds_since(t_dist);
 
+  // §6b orientation: an output face is flipped when the nearest input surface that faces its way
+  // is more than flip_tolerance farther than the nearest input surface (coincident two-sided
+  // input geometry is therefore not a flip).
+  {
+    std::vector<Vec3> normal_in(soup_in.triangles.size());
+    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
+      const auto& tri = soup_in.triangles[t];
+      normal_in[t] = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    }
+    for (Index f = 0; f < out.num_faces(); ++f) {
+      const Vec3 n_out = face_area_vector(out, f);
+      if (n_out.isZero(0.0)) continue;
+      const Vec3 c = face_centroid(out, f);
+      const NearestHit any = bvh_in.nearest(c);
+      if (any.primitive == kInvalidIndex) continue;
+      const NearestHit agreeing = bvh_in.nearest_if(c, [&](Index t) { return normal_in[t].dot(n_out) >= 0.0; });
+      if (agreeing.primitive == kInvalidIndex ||
+          std::sqrt(agreeing.distance_sq) > std::sqrt(any.distance_sq) + params.flip_tolerance)
+        ++r.flipped_faces;
+    }
+  }
+
   // §6 flow deviation on the output samples that lie on quads.
   {
     std::vector<char> frame_done_in(in.num_faces(), 0), frame_done_out(out.num_faces(), 0);
@@ -512,6 +534,7 @@ nlohmann::json to_json(const EvalResult& r) {
   j["flow_deviation_deg"] = num(r.flow_deviation_deg);
   j["flow_deviation_p90_deg"] = num(r.flow_deviation_p90_deg);
   j["flow_coverage"] = num(r.flow_coverage);
+  j["flipped_faces"] = r.flipped_faces;
   j["seed"] = r.seed;
   j["samples_in"] = r.samples_in;
   j["samples_out"] = r.samples_out;
