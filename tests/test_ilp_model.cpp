@@ -716,3 +716,39 @@ TEST(IlpCbc, StartAsCutoffProvenOptimal) {
   EXPECT_DOUBLE_EQ(r.objective, -1.0);
   EXPECT_EQ(r.solution, (std::vector<double>{1.0, 0.0}));
 }
+
+TEST(IlpModel, WithoutFixedColumnsMovesConstantsIntoRowsAndOffset) {
+  // min 2a + 3b + c  s.t.  a + b + c >= 2,  b - c <= 0,  a fixed at 1.
+  Model m;
+  const Col a = m.add_binary(2.0);
+  const Col b = m.add_binary(3.0);
+  const Col c = m.add_binary(1.0);
+  m.set_bounds(a, 1.0, 1.0);
+  m.add_ge({{a, 1.0}, {b, 1.0}, {c, 1.0}}, 2.0);
+  m.add_le({{b, 1.0}, {c, -1.0}}, 0.0);
+  m.add_le({{a, 1.0}}, 1.0);  // constant after substitution: dropped, satisfied
+  m.set_initial_solution({1.0, 1.0, 1.0});
+  const ReducedModel r = without_fixed_columns(m);
+  ASSERT_EQ(r.model.num_cols(), 2u);
+  EXPECT_EQ(r.kept, (std::vector<Col>{b, c}));
+  EXPECT_EQ(r.model.num_rows(), 2u);
+  EXPECT_EQ(r.violated_constant_rows, 0u);
+  EXPECT_DOUBLE_EQ(r.model.objective_offset(), 2.0);
+  EXPECT_DOUBLE_EQ(r.model.row_lower(0), 1.0);  // b + c >= 2 - 1
+  EXPECT_EQ(r.model.initial_solution(), (std::vector<double>{1.0, 1.0}));
+  // Same optimum through the reduced model: b = 0, c = 1, objective 2 + 1 = 3.
+  SolveParams params;
+  params.time_limit_seconds = 10;
+  const SolveResult s = solve(r.model, params);
+  ASSERT_EQ(s.status, SolveStatus::Optimal) << describe(s);
+  EXPECT_DOUBLE_EQ(s.objective, 3.0);
+  const std::vector<double> x = r.expand(m, s.solution);
+  EXPECT_EQ(x, (std::vector<double>{1.0, 0.0, 1.0}));
+  EXPECT_DOUBLE_EQ(m.evaluate(x), 3.0);
+  // A fixed column that breaks a row is reported.
+  Model bad;
+  const Col z = bad.add_binary();
+  bad.set_bounds(z, 0.0, 0.0);
+  bad.add_ge({{z, 1.0}}, 1.0);
+  EXPECT_EQ(without_fixed_columns(bad).violated_constant_rows, 1u);
+}

@@ -48,6 +48,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--strategy", opt->strategy,
                   "auto, whole (one MIP) or neighbourhoods (large-neighbourhood search); fast formulation only")
       ->check(CLI::IsMember({"auto", "whole", "neighbourhoods"}))->capture_default_str()->group("Solver");
+  sub->add_option("--neighbourhood-groups", p.neighbourhood_groups,
+                  "Groups freed per neighbourhood MIP (strategy neighbourhoods)")
+      ->check(CLI::Range(1, 1000000))->capture_default_str()->group("Solver");
   sub->add_option("--epsilon-n", p.epsilon_n, "Eq. 2 slack on the target")
       ->check(CLI::Range(0.0, 0.5))->capture_default_str()->group("Paper parameters");
   sub->add_option("--epsilon-theta", p.epsilon_theta_deg, "Segmentation breakpoint angle, degrees (§3.2.2)")

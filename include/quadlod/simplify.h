@@ -41,6 +41,8 @@ struct SimplifyOptions {
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
   /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).
   std::string strategy = "auto";
+  /// Groups freed per neighbourhood MIP (docs/parameters.md, "Solver strategy").
+  Index neighbourhood_groups = 400;
   std::string solver = "cbc";
 
   // --- rounds (beyond the paper) ------------------------------------------------------------

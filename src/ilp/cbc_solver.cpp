@@ -279,7 +279,8 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
                                    "-randomCbcSeed", seed.c_str()};
   if (std::isfinite(time_limit)) argv.insert(argv.end(), {"-sec", seconds.c_str()});
   if (backend::resolve_threads(params) > 1) argv.insert(argv.end(), {"-threads", threads.c_str()});
-  if (!preprocess) argv.insert(argv.end(), {"-preprocess", "off"});
+  if (!preprocess || params.light) argv.insert(argv.end(), {"-preprocess", "off"});
+  if (params.light) argv.insert(argv.end(), {"-cutsOnOff", "off", "-heuristicsOnOff", "off"});
   if (std::isfinite(cutoff)) argv.insert(argv.end(), {"-cutoff", cutoff_arg.c_str()});
   argv.insert(argv.end(), {"-solve", "-quit"});
 

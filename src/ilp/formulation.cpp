@@ -801,6 +801,139 @@ double group_objective(const Groups& g, const GroupConstraints& gc, const FaceGr
          params.lambda_edge * importance + params.lambda_tri * split;
 }
 
+// Local search over single-group flips (beyond the paper; docs/formulation.md, "Speed"): from a
+// feasible selection, repeatedly flip one group (collapse a kept one, or keep a collapsed one)
+// whenever that lowers Eq. 9 and keeps Eq. 2's band and Eq. 8, by exact incremental deltas, until
+// a full pass finds nothing or time runs out. Then pairs of adjacent groups are swapped (one
+// collapsed, one kept), which keeps the count roughly where it is, so that moves the count term
+// alone would block are found too. Milliseconds per pass on the largest corpus meshes.
+struct FlipSearchStats {
+  Index passes = 0;
+  Index flips = 0;
+  Index swaps = 0;
+  bool converged = false;
+};
+
+std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                      std::vector<std::uint8_t> y, std::uint64_t target,
+                                      const SelectionParams& params, double seconds,
+                                      const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
+                                      FlipSearchStats& stats) {
+  Stopwatch clock;
+  const Index nf = static_cast<Index>(fg.degree.size());
+  std::vector<Index> gf_offsets(std::size_t{g.count} + 1, 0), gf;
+  for (Index f = 0; f < nf; ++f)
+    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) ++gf_offsets[fg.group[i] + 1];
+  std::partial_sum(gf_offsets.begin(), gf_offsets.end(), gf_offsets.begin());
+  gf.resize(gf_offsets.back());
+  {
+    std::vector<Index> fill(gf_offsets.begin(), gf_offsets.end() - 1);
+    for (Index f = 0; f < nf; ++f)
+      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) gf[fill[fg.group[i]]++] = f;
+  }
+  std::vector<std::vector<Index>> tri_nbrs(gc.tri.size());
+  for (const auto& [i, j] : gc.tri_neighbours) tri_nbrs[i].push_back(j);
+
+  std::int64_t count = 0;
+  for (Index f = 0; f < nf; ++f) count += face_count(fg, f, y);
+  std::vector<Index> geo_kept(gc.geo.size(), 0);
+  for (std::size_t c = 0; c < gc.geo.size(); ++c)
+    for (Index grp : gc.geo[c]) geo_kept[c] += y[grp];
+  std::vector<Index> tri_collapsed(gc.tri.size(), 0);
+  for (std::size_t c = 0; c < gc.tri.size(); ++c)
+    for (Index grp : gc.tri[c]) tri_collapsed[c] += !y[grp];
+  const double n = double(target), band = params.epsilon_n * n;
+
+  // Change of N' when grp flips (faces are re-counted with the flipped bit).
+  auto delta_count = [&](Index grp) {
+    std::int64_t d = 0;
+    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) d -= face_count(fg, gf[k], y);
+    y[grp] ^= 1;
+    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) d += face_count(fg, gf[k], y);
+    y[grp] ^= 1;
+    return d;
+  };
+  // Eq. 9 change of flipping grp, except the count term.
+  auto delta_rest = [&](Index grp) {
+    const bool collapse = y[grp];
+    double d = collapse ? params.lambda_edge * g.importance[grp] : -params.lambda_edge * g.importance[grp];
+    for (Index cl : gc.group_geo[grp]) {
+      if (collapse && geo_kept[cl] == 1) d += params.lambda_geo;
+      if (!collapse && geo_kept[cl] == 0) d -= params.lambda_geo;
+    }
+    for (Index partner : gc.group_split[grp]) d += (y[partner] == y[grp]) ? params.lambda_tri : -params.lambda_tri;
+    return d;
+  };
+  // Eq. 8 for collapsing grp (keeping a group never breaks it).
+  auto may_collapse = [&](Index grp) {
+    for (Index i : gc.group_tri[grp])
+      for (Index j : tri_nbrs[i]) {
+        if (tri_collapsed[j] > 0) return false;
+        if (std::binary_search(gc.tri[j].begin(), gc.tri[j].end(), grp)) return false;
+      }
+    return true;
+  };
+  auto apply = [&](Index grp, std::int64_t dc) {
+    const bool collapse = y[grp];
+    y[grp] ^= 1;
+    count += dc;
+    for (Index cl : gc.group_geo[grp]) geo_kept[cl] += collapse ? -1 : 1;
+    for (Index cl : gc.group_tri[grp]) tri_collapsed[cl] += collapse ? 1 : -1;
+  };
+  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
+  const double eps = 1e-9;
+
+  bool improved = true;
+  while (improved && clock.seconds() < seconds) {
+    improved = false;
+    ++stats.passes;
+    for (Index grp = 0; grp < g.count && clock.seconds() < seconds; ++grp) {
+      if (g.fixed[grp]) continue;
+      if (y[grp] && !may_collapse(grp)) continue;
+      const std::int64_t dc = delta_count(grp);
+      if (std::abs(double(count + dc) - n) > band) continue;
+      const double gain = count_term(count + dc) - count_term(count) + delta_rest(grp);
+      if (gain < -eps) {
+        apply(grp, dc);
+        ++stats.flips;
+        improved = true;
+      }
+    }
+    // Swaps: keep b (collapsed) and collapse a neighbour a (kept), evaluated as one move.
+    for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
+      if (g.fixed[b] || y[b]) continue;
+      const std::int64_t db = delta_count(b);
+      const double rb = delta_rest(b);
+      if (rb >= 0.0) continue;  // keeping b must pay for something besides the count
+      apply(b, db);
+      Index best_a = kInvalidIndex;
+      std::int64_t best_da = 0;
+      double best_gain = -eps;
+      for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
+        const Index a = adjacent[k];
+        if (g.fixed[a] || !y[a] || !may_collapse(a)) continue;
+        const std::int64_t da = delta_count(a);
+        if (std::abs(double(count + da) - n) > band) continue;
+        const double gain = count_term(count + da) - count_term(count - db) + rb + delta_rest(a);
+        if (gain < best_gain) {
+          best_gain = gain;
+          best_a = a;
+          best_da = da;
+        }
+      }
+      if (best_a != kInvalidIndex) {
+        apply(best_a, best_da);
+        ++stats.swaps;
+        improved = true;
+      } else {
+        apply(b, -db);  // undo
+      }
+    }
+  }
+  stats.converged = !improved;
+  return y;
+}
+
 // Groups that share a face, as CSR.
 void group_adjacency(const Groups& g, const FaceGroups& fg, std::vector<Index>& offsets,
                      std::vector<Index>& adjacent) {
@@ -888,10 +1021,10 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   // (everything else fixed at the incumbent, the greedy selection as cutoff) is solved and an
   // improvement is kept. Seeds sweep the groups in index order; a sweep without improvement ends
   // the search.
+  std::vector<Index> adj_offsets, adjacent;  // groups that share a face
+  group_adjacency(groups, fg, adj_offsets, adjacent);
   auto neighbourhood_search = [&](std::vector<std::uint8_t> y, double seconds) {
     Stopwatch lns_clock;
-    std::vector<Index> adj_offsets, adjacent;
-    group_adjacency(groups, fg, adj_offsets, adjacent);
     double best = group_objective(groups, gc, fg, y, target, params);
     std::vector<std::uint8_t> free(groups.count, 0), covered(groups.count, 0);
     std::vector<Index> stamp(groups.count, kInvalidIndex), queue, freed;
@@ -931,20 +1064,25 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
             queue.push_back(adjacent[k]);
           }
       }
+      Stopwatch build_clock;
       ModelBuilder sub(mesh, conn, analysis, groups, gc, fg, importance, params);
       sub.set_scope(free, y);
       sub.build(target, true);
       sub.model.set_initial_solution(sub.complete(y, target));
+      result.seconds_neighbourhood_build += build_clock.seconds();
       ilp::SolveParams sp = params.solve;
       sp.start_as_mip_start = params.greedy_as_mip_start;
       sp.time_limit_seconds =
           std::max(1e-3, std::min(params.neighbourhood_time_limit, seconds - lns_clock.seconds()));
-      const ilp::SolveResult r = solver->solve(sub.model, sp);
+      sp.isolate_process = params.isolate_neighbourhoods;
+      sp.light = params.light_neighbourhoods;
+      const ilp::ReducedModel reduced = ilp::without_fixed_columns(sub.model);
+      const ilp::SolveResult r = solver->solve(reduced.model, sp);
       ++result.neighbourhoods;
       summary.nodes += r.nodes;
       summary.iterations += r.iterations;
-      if (r.has_solution() && !r.solution_is_start) {
-        std::vector<std::uint8_t> candidate = sub.group_bits(r.solution);
+      if (r.has_solution() && !r.solution_is_start && reduced.violated_constant_rows == 0) {
+        std::vector<std::uint8_t> candidate = sub.group_bits(reduced.expand(sub.model, r.solution));
         const double value = group_objective(groups, gc, fg, candidate, target, params);
         if (value < best - 1e-9 * std::max(1.0, std::abs(best))) {
           best = value;
@@ -972,10 +1110,24 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     return y;
   };
 
+  // The greedy selection, polished by single flips and adjacent swaps, is the start of every
+  // solve (skipped for a greedy-only run and when the greedy misses the band).
+  std::vector<std::uint8_t> start_y = greedy.y;
+  if (reachable && time_limit > 0.0) {
+    Stopwatch flip_clock;
+    FlipSearchStats fs;
+    start_y = flip_search(groups, gc, fg, std::move(start_y), target, params,
+                          params.flip_search_time_fraction * time_limit, adj_offsets, adjacent, fs);
+    result.flip_passes = fs.passes;
+    result.flips = fs.flips;
+    result.swaps = fs.swaps;
+    result.seconds_flip_search = flip_clock.seconds();
+  }
+
   Stopwatch build_clock;
   ModelBuilder banded(mesh, conn, analysis, groups, gc, fg, importance, params);
   banded.build(target, true);
-  const std::vector<double> banded_start = banded.complete(greedy.y, target);
+  const std::vector<double> banded_start = banded.complete(start_y, target);
   if (reachable) banded.model.set_initial_solution(banded_start);
   result.model = banded.stats;
   result.model.size = banded.model.size();
@@ -990,12 +1142,13 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
        (params.strategy == SelectionParams::Strategy::Auto && free_groups > params.neighbourhood_groups));
   result.strategy = time_limit > 0.0 ? (neighbourhoods ? "neighbourhoods" : "whole") : "greedy";
   if (reachable) {
-    result.greedy_objective = banded.model.evaluate(banded_start);
+    result.greedy_objective = banded.model.evaluate(banded.complete(greedy.y, target));
+    result.flip_search_objective = banded.model.evaluate(banded_start);
     // The budget covers the whole selection: what building the model and the greedy took is
     // subtracted (at least 10 % of it is left to the solver).
     const double budget = std::max(0.1 * time_limit, time_limit - clock.seconds());
     if (time_limit > 0.0 && neighbourhoods) {
-      solution = banded.complete(neighbourhood_search(greedy.y, budget), target);
+      solution = banded.complete(neighbourhood_search(start_y, budget), target);
     } else {
       solution = time_limit > 0.0 ? run(banded, budget) : banded_start;
     }

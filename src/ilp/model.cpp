@@ -478,3 +478,54 @@ std::string Model::write_lp(const std::filesystem::path& path) const {
 }
 
 }  // namespace quadlod::ilp
+
+namespace quadlod::ilp {
+
+ReducedModel without_fixed_columns(const Model& model, double tolerance) {
+  ReducedModel r;
+  const Col n = model.num_cols();
+  std::vector<Col> new_index(n, ~Col{0});
+  double offset = model.objective_offset();
+  for (Col c = 0; c < n; ++c) {
+    if (model.col_lower(c) == model.col_upper(c)) {
+      offset += model.objective(c) * model.col_lower(c);
+      continue;
+    }
+    new_index[c] = static_cast<Col>(r.kept.size());
+    r.kept.push_back(c);
+    r.model.add_var(model.col_type(c), model.col_lower(c), model.col_upper(c), model.objective(c));
+  }
+  r.model.set_objective_offset(offset);
+  std::vector<Term> terms;
+  for (Row row = 0; row < model.num_rows(); ++row) {
+    terms.clear();
+    double constant = 0.0;
+    const auto cols = model.row_cols(row);
+    const auto coefs = model.row_coefs(row);
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      if (new_index[cols[k]] == ~Col{0}) constant += coefs[k] * model.col_lower(cols[k]);
+      else terms.push_back({new_index[cols[k]], coefs[k]});
+    }
+    const double lo = model.row_lower(row), hi = model.row_upper(row);
+    if (terms.empty()) {
+      if (constant < lo - tolerance || constant > hi + tolerance) ++r.violated_constant_rows;
+      continue;
+    }
+    r.model.add_range(lo == -kInf ? -kInf : lo - constant, terms, hi == kInf ? kInf : hi - constant);
+  }
+  if (model.has_initial_solution()) {
+    std::vector<double> start(r.kept.size());
+    for (std::size_t k = 0; k < r.kept.size(); ++k) start[k] = model.initial_solution()[r.kept[k]];
+    r.model.set_initial_solution(std::move(start));
+  }
+  return r;
+}
+
+std::vector<double> ReducedModel::expand(const Model& original, const std::vector<double>& reduced) const {
+  std::vector<double> x(original.num_cols());
+  for (Col c = 0; c < original.num_cols(); ++c) x[c] = original.col_lower(c);
+  for (std::size_t k = 0; k < kept.size() && k < reduced.size(); ++k) x[kept[k]] = reduced[k];
+  return x;
+}
+
+}  // namespace quadlod::ilp

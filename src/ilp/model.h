@@ -232,3 +232,21 @@ class Model {
 };
 
 }  // namespace quadlod::ilp
+
+namespace quadlod::ilp {
+
+/// A model with its fixed columns (lower == upper) substituted out: their contribution moves to
+/// the row bounds and the objective offset, rows left without a column are dropped. Backends
+/// would presolve them away too, but loading and presolving tens of thousands of fixed columns
+/// costs more than solving a small neighbourhood (the large-neighbourhood search of
+/// src/ilp/formulation.cpp solves such models by the hundred).
+struct ReducedModel {
+  Model model;
+  std::vector<Col> kept;         ///< reduced column → original column
+  Row violated_constant_rows = 0;  ///< dropped rows whose constant violates their bounds
+  /// The original column vector for a reduced solution (fixed columns at their value).
+  std::vector<double> expand(const Model& original, const std::vector<double>& reduced) const;
+};
+ReducedModel without_fixed_columns(const Model& model, double tolerance = 1e-9);
+
+}  // namespace quadlod::ilp

@@ -56,6 +56,10 @@ struct SolveParams {
   /// greedy start, 1 s and 3 s solves ended 0.2-2.6 % worse with the start than without it in
   /// 12 of 12 runs. A good start (e.g. a previous solution) helps through its cutoff.
   bool start_as_mip_start = true;
+  /// Plain branch-and-bound: no cut generation, no primal heuristics, no pre-processing. For
+  /// many small MIPs with a good start (the neighbourhoods of src/ilp/formulation.cpp), where
+  /// those stages cost more than the search (CBC: ~70 ms per call on a 100-group neighbourhood).
+  bool light = false;
   /// Run the backend in a child process (POSIX fork; the CBC backend). A crash inside the solver
   /// library — seen with Debian's CBC 2.10.8: SIGSEGV in CglPreProcess::postProcess, SIGABRT on
   /// a Clp assertion — then ends only that child: the solve reports "no solution" with a warning

@@ -72,6 +72,12 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"neighbourhoods_improved", s.neighbourhoods_improved},
       {"neighbourhood_sweeps", s.neighbourhood_sweeps},
       {"neighbourhoods_converged", s.neighbourhoods_converged},
+      {"seconds_neighbourhood_build", s.seconds_neighbourhood_build},
+      {"flip_search_objective", s.flip_search_objective},
+      {"flip_passes", s.flip_passes},
+      {"flips", s.flips},
+      {"swaps", s.swaps},
+      {"seconds_flip_search", s.seconds_flip_search},
       {"seconds_build", s.seconds_build},
       {"seconds_greedy", s.seconds_greedy},
       {"seconds_solve", s.seconds_solve},
@@ -147,6 +153,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (options.lambda_edge >= 0.0) sp.lambda_edge = options.lambda_edge;
   if (options.lambda_tri >= 0.0) sp.lambda_tri = options.lambda_tri;
   sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
+  sp.neighbourhood_groups = std::max<Index>(1, options.neighbourhood_groups);
   if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
   else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
   else if (options.strategy != "auto") {
@@ -331,6 +338,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"seed", options.seed},
       {"formulation", options.exact_formulation ? "exact" : "fast"},
       {"strategy", options.strategy},
+      {"neighbourhood_groups", sp.neighbourhood_groups},
       {"consistency", options.consistency},
       {"segmentation", options.segmentation},
       {"geometry", options.geometry},
