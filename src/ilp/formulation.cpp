@@ -112,13 +112,7 @@ Groups make_groups(const Connectivity& conn, const AnalysisResult& analysis,
       for (std::size_t i = 1; i < s.opposing_edges.size(); ++i)
         uf.unite(s.opposing_edges[0], s.opposing_edges[i]);
   Groups g;
-  g.edge_group.assign(conn.num_edges, kInvalidIndex);
-  std::vector<Index> root_group(conn.num_edges, kInvalidIndex);
-  for (Index e = 0; e < conn.num_edges; ++e) {
-    const Index r = uf.find(e);
-    if (root_group[r] == kInvalidIndex) root_group[r] = g.count++;
-    g.edge_group[e] = root_group[r];
-  }
+  g.edge_group = uf.dense_labels(g.count);
   g.offsets.assign(std::size_t{g.count} + 1, 0);
   for (Index e = 0; e < conn.num_edges; ++e) ++g.offsets[g.edge_group[e] + 1];
   std::partial_sum(g.offsets.begin(), g.offsets.end(), g.offsets.begin());
@@ -235,6 +229,85 @@ inline Index face_count(const FaceGroups& fg, Index f, const std::vector<std::ui
 }
 
 // ------------------------------------------------------------------------------------------
+// The incremental state the greedy and the flip search work on: group bits, N', kept groups per
+// Eq. 6 cluster, collapsed groups per Eq. 7 cluster, and the group → faces index for the count.
+class SelectionState {
+ public:
+  SelectionState(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg, std::vector<std::uint8_t> bits)
+      : y(std::move(bits)), g_(g), gc_(gc), fg_(fg) {
+    const Index nf = static_cast<Index>(fg.degree.size());
+    face_offsets_.assign(std::size_t{g.count} + 1, 0);
+    for (Index f = 0; f < nf; ++f)
+      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) ++face_offsets_[fg.group[i] + 1];
+    std::partial_sum(face_offsets_.begin(), face_offsets_.end(), face_offsets_.begin());
+    faces_.resize(face_offsets_.back());
+    std::vector<Index> fill(face_offsets_.begin(), face_offsets_.end() - 1);
+    for (Index f = 0; f < nf; ++f)
+      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) faces_[fill[fg.group[i]]++] = f;
+    tri_nbrs_.resize(gc.tri.size());
+    for (const auto& [i, j] : gc.tri_neighbours) tri_nbrs_[i].push_back(j);
+    for (Index f = 0; f < nf; ++f) count += face_count(fg, f, y);
+    geo_kept_.assign(gc.geo.size(), 0);
+    for (std::size_t c = 0; c < gc.geo.size(); ++c)
+      for (Index grp : gc.geo[c]) geo_kept_[c] += y[grp];
+    tri_collapsed_.assign(gc.tri.size(), 0);
+    for (std::size_t c = 0; c < gc.tri.size(); ++c)
+      for (Index grp : gc.tri[c]) tri_collapsed_[c] += !y[grp];
+  }
+
+  /// Change of N' (Eq. 1) if grp flips.
+  std::int64_t delta_count(Index grp) {
+    std::int64_t d = 0;
+    for (Index k = face_offsets_[grp]; k < face_offsets_[grp + 1]; ++k) d -= face_count(fg_, faces_[k], y);
+    y[grp] ^= 1;
+    for (Index k = face_offsets_[grp]; k < face_offsets_[grp + 1]; ++k) d += face_count(fg_, faces_[k], y);
+    y[grp] ^= 1;
+    return d;
+  }
+  /// Change of Eq. 9 without the count term if grp flips: λ_edge Q, λ_geo when grp is the last
+  /// kept group of a cluster (or the first kept again), λ_tri per quad side pair split or mended.
+  double delta_rest(Index grp, const SelectionParams& params) const {
+    const bool collapse = y[grp];
+    double d = (collapse ? 1.0 : -1.0) * params.lambda_edge * g_.importance[grp];
+    for (Index cl : gc_.group_geo[grp]) {
+      if (collapse && geo_kept_[cl] == 1) d += params.lambda_geo;
+      if (!collapse && geo_kept_[cl] == 0) d -= params.lambda_geo;
+    }
+    for (Index partner : gc_.group_split[grp]) d += (y[partner] == y[grp]) ? params.lambda_tri : -params.lambda_tri;
+    return d;
+  }
+  /// Eq. 8 for collapsing grp: a cluster that loses an edge needs every neighbour untouched, and
+  /// grp must not belong to such a neighbour (keeping a group never breaks Eq. 8).
+  bool may_collapse(Index grp) const {
+    for (Index i : gc_.group_tri[grp])
+      for (Index j : tri_nbrs_[i]) {
+        if (tri_collapsed_[j] > 0) return false;
+        if (std::binary_search(gc_.tri[j].begin(), gc_.tri[j].end(), grp)) return false;
+      }
+    return true;
+  }
+  /// Flips grp; `dc` = delta_count(grp).
+  void flip(Index grp, std::int64_t dc) {
+    const bool collapse = y[grp];
+    y[grp] ^= 1;
+    count += dc;
+    for (Index cl : gc_.group_geo[grp]) geo_kept_[cl] += collapse ? Index(-1) : 1;
+    for (Index cl : gc_.group_tri[grp]) tri_collapsed_[cl] += collapse ? 1 : Index(-1);
+  }
+
+  std::vector<std::uint8_t> y;
+  std::int64_t count = 0;
+
+ private:
+  const Groups& g_;
+  const GroupConstraints& gc_;
+  const FaceGroups& fg_;
+  std::vector<Index> face_offsets_, faces_;
+  std::vector<std::vector<Index>> tri_nbrs_;
+  std::vector<Index> geo_kept_, tri_collapsed_;
+};
+
+// ------------------------------------------------------------------------------------------
 // Greedy selection: collapse groups in order of cost per removed triangle-equivalent until the
 // count reaches the target, never leaving the Eq. 2 band below and never breaking Eq. 8.
 struct GreedyResult {
@@ -243,56 +316,8 @@ struct GreedyResult {
 };
 
 GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
-                           std::uint64_t input_count, std::uint64_t target,
-                           const SelectionParams& params) {
-  GreedyResult r;
-  r.y.assign(g.count, 1);
-  r.count = input_count;
-  // group → faces touching it
-  std::vector<Index> gf_offsets(std::size_t{g.count} + 1, 0), gf;
-  const Index nf = static_cast<Index>(fg.degree.size());
-  for (Index f = 0; f < nf; ++f)
-    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) ++gf_offsets[fg.group[i] + 1];
-  std::partial_sum(gf_offsets.begin(), gf_offsets.end(), gf_offsets.begin());
-  gf.resize(gf_offsets.back());
-  {
-    std::vector<Index> fill(gf_offsets.begin(), gf_offsets.end() - 1);
-    for (Index f = 0; f < nf; ++f)
-      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) gf[fill[fg.group[i]]++] = f;
-  }
-  std::vector<Index> geo_kept(gc.geo.size());
-  for (std::size_t c = 0; c < gc.geo.size(); ++c) geo_kept[c] = static_cast<Index>(gc.geo[c].size());
-  std::vector<Index> tri_collapsed(gc.tri.size(), 0);
-  std::vector<std::vector<Index>> tri_nbrs(gc.tri.size());
-  for (const auto& [i, j] : gc.tri_neighbours) tri_nbrs[i].push_back(j);
-
-  auto removed = [&](Index grp) -> std::int64_t {
-    std::int64_t delta = 0;
-    r.y[grp] = 0;
-    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) delta -= face_count(fg, gf[k], r.y);
-    r.y[grp] = 1;
-    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) delta += face_count(fg, gf[k], r.y);
-    return delta;
-  };
-  auto cost = [&](Index grp) {
-    double c = params.lambda_edge * g.importance[grp];
-    for (Index cl : gc.group_geo[grp])
-      if (geo_kept[cl] == 1) c += params.lambda_geo;
-    // Collapsing grp splits pairs whose partner is kept and mends those whose partner is gone.
-    for (Index partner : gc.group_split[grp]) c += r.y[partner] ? params.lambda_tri : -params.lambda_tri;
-    return c;
-  };
-  auto allowed = [&](Index grp) {
-    // Eq. 8: a cluster that loses an edge needs every neighbour untouched, and grp must not
-    // belong to such a neighbour.
-    for (Index i : gc.group_tri[grp])
-      for (Index j : tri_nbrs[i]) {
-        if (tri_collapsed[j] > 0) return false;
-        if (std::binary_search(gc.tri[j].begin(), gc.tri[j].end(), grp)) return false;
-      }
-    return true;
-  };
-
+                           std::uint64_t target, const SelectionParams& params) {
+  SelectionState st(g, gc, fg, std::vector<std::uint8_t>(g.count, 1));
   struct Entry {
     double key;
     Index group;
@@ -300,9 +325,10 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
     bool operator<(const Entry& o) const { return key > o.key || (key == o.key && group > o.group); }
   };
   std::priority_queue<Entry> heap;
+  // Key: cost per removed triangle-equivalent of collapsing a kept group.
   auto push = [&](Index grp) {
-    const std::int64_t d = removed(grp);
-    if (d > 0) heap.push({cost(grp) / double(d), grp, d});
+    const std::int64_t d = -st.delta_count(grp);
+    if (d > 0) heap.push({st.delta_rest(grp, params) / double(d), grp, d});
   };
   for (Index grp = 0; grp < g.count; ++grp)
     if (!g.fixed[grp]) push(grp);
@@ -312,44 +338,39 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
   // the end if the band was never reached and it gets closer than where the greedy stopped.
   Index closest_skipped = kInvalidIndex;
   double closest_distance = INFINITY;
-  while (r.count > target && !heap.empty()) {
+  while (st.count > std::int64_t(target) && !heap.empty()) {
     const Entry top = heap.top();
     heap.pop();
-    if (!r.y[top.group]) continue;
-    const std::int64_t d = removed(top.group);
+    if (!st.y[top.group]) continue;
+    const std::int64_t d = -st.delta_count(top.group);
     if (d <= 0) continue;
-    const double key = cost(top.group) / double(d);
-    if (d != top.delta || key != top.key) {
+    const double key = st.delta_rest(top.group, params) / double(d);
+    if (d != top.delta || key != top.key) {  // stale entry: its neighbours changed
       heap.push({key, top.group, d});
       continue;
     }
-    if (!allowed(top.group)) continue;
+    if (!st.may_collapse(top.group)) continue;
     // A group that would jump below the band is skipped: smaller ones may still fit.
-    if (double(r.count) - double(d) < lowest) {
-      const double distance = std::abs(double(r.count) - double(d) - double(target));
+    if (double(st.count) - double(d) < lowest) {
+      const double distance = std::abs(double(st.count) - double(d) - double(target));
       if (distance < closest_distance) {
         closest_distance = distance;
         closest_skipped = top.group;
       }
       continue;
     }
-    r.y[top.group] = 0;
-    r.count -= static_cast<std::uint64_t>(d);
+    st.flip(top.group, -d);
     for (Index partner : gc.group_split[top.group])  // their λ_tri cost just dropped
-      if (r.y[partner] && !g.fixed[partner]) push(partner);
-    for (Index cl : gc.group_geo[top.group]) --geo_kept[cl];
-    for (Index cl : gc.group_tri[top.group]) ++tri_collapsed[cl];
+      if (st.y[partner] && !g.fixed[partner]) push(partner);
   }
-  if (double(r.count) > (1.0 + params.epsilon_n) * double(target) && closest_skipped != kInvalidIndex &&
-      r.y[closest_skipped] && allowed(closest_skipped)) {
-    const std::int64_t d = removed(closest_skipped);
-    if (d > 0 && std::abs(double(r.count) - double(d) - double(target)) <
-                     std::abs(double(r.count) - double(target))) {
-      r.y[closest_skipped] = 0;
-      r.count -= static_cast<std::uint64_t>(d);
-    }
+  if (double(st.count) > (1.0 + params.epsilon_n) * double(target) && closest_skipped != kInvalidIndex &&
+      st.y[closest_skipped] && st.may_collapse(closest_skipped)) {
+    const std::int64_t d = -st.delta_count(closest_skipped);
+    if (d > 0 && std::abs(double(st.count) - double(d) - double(target)) <
+                     std::abs(double(st.count) - double(target)))
+      st.flip(closest_skipped, -d);
   }
-  return r;
+  return {std::move(st.y), static_cast<std::uint64_t>(st.count)};
 }
 
 // ------------------------------------------------------------------------------------------
@@ -820,101 +841,42 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
                                       const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
                                       FlipSearchStats& stats) {
   Stopwatch clock;
-  const Index nf = static_cast<Index>(fg.degree.size());
-  std::vector<Index> gf_offsets(std::size_t{g.count} + 1, 0), gf;
-  for (Index f = 0; f < nf; ++f)
-    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) ++gf_offsets[fg.group[i] + 1];
-  std::partial_sum(gf_offsets.begin(), gf_offsets.end(), gf_offsets.begin());
-  gf.resize(gf_offsets.back());
-  {
-    std::vector<Index> fill(gf_offsets.begin(), gf_offsets.end() - 1);
-    for (Index f = 0; f < nf; ++f)
-      for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) gf[fill[fg.group[i]]++] = f;
-  }
-  std::vector<std::vector<Index>> tri_nbrs(gc.tri.size());
-  for (const auto& [i, j] : gc.tri_neighbours) tri_nbrs[i].push_back(j);
-
-  std::int64_t count = 0;
-  for (Index f = 0; f < nf; ++f) count += face_count(fg, f, y);
-  std::vector<Index> geo_kept(gc.geo.size(), 0);
-  for (std::size_t c = 0; c < gc.geo.size(); ++c)
-    for (Index grp : gc.geo[c]) geo_kept[c] += y[grp];
-  std::vector<Index> tri_collapsed(gc.tri.size(), 0);
-  for (std::size_t c = 0; c < gc.tri.size(); ++c)
-    for (Index grp : gc.tri[c]) tri_collapsed[c] += !y[grp];
-  const double n = double(target), band = params.epsilon_n * n;
-
-  // Change of N' when grp flips (faces are re-counted with the flipped bit).
-  auto delta_count = [&](Index grp) {
-    std::int64_t d = 0;
-    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) d -= face_count(fg, gf[k], y);
-    y[grp] ^= 1;
-    for (Index k = gf_offsets[grp]; k < gf_offsets[grp + 1]; ++k) d += face_count(fg, gf[k], y);
-    y[grp] ^= 1;
-    return d;
-  };
-  // Eq. 9 change of flipping grp, except the count term.
-  auto delta_rest = [&](Index grp) {
-    const bool collapse = y[grp];
-    double d = collapse ? params.lambda_edge * g.importance[grp] : -params.lambda_edge * g.importance[grp];
-    for (Index cl : gc.group_geo[grp]) {
-      if (collapse && geo_kept[cl] == 1) d += params.lambda_geo;
-      if (!collapse && geo_kept[cl] == 0) d -= params.lambda_geo;
-    }
-    for (Index partner : gc.group_split[grp]) d += (y[partner] == y[grp]) ? params.lambda_tri : -params.lambda_tri;
-    return d;
-  };
-  // Eq. 8 for collapsing grp (keeping a group never breaks it).
-  auto may_collapse = [&](Index grp) {
-    for (Index i : gc.group_tri[grp])
-      for (Index j : tri_nbrs[i]) {
-        if (tri_collapsed[j] > 0) return false;
-        if (std::binary_search(gc.tri[j].begin(), gc.tri[j].end(), grp)) return false;
-      }
-    return true;
-  };
-  auto apply = [&](Index grp, std::int64_t dc) {
-    const bool collapse = y[grp];
-    y[grp] ^= 1;
-    count += dc;
-    for (Index cl : gc.group_geo[grp]) geo_kept[cl] += collapse ? -1 : 1;
-    for (Index cl : gc.group_tri[grp]) tri_collapsed[cl] += collapse ? 1 : -1;
-  };
+  SelectionState st(g, gc, fg, std::move(y));
+  const double n = double(target), band = params.epsilon_n * n, eps = 1e-9;
   auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
-  const double eps = 1e-9;
+  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
 
   bool improved = true;
   while (improved && clock.seconds() < seconds) {
     improved = false;
     ++stats.passes;
     for (Index grp = 0; grp < g.count && clock.seconds() < seconds; ++grp) {
-      if (g.fixed[grp]) continue;
-      if (y[grp] && !may_collapse(grp)) continue;
-      const std::int64_t dc = delta_count(grp);
-      if (std::abs(double(count + dc) - n) > band) continue;
-      const double gain = count_term(count + dc) - count_term(count) + delta_rest(grp);
-      if (gain < -eps) {
-        apply(grp, dc);
+      if (g.fixed[grp] || (st.y[grp] && !st.may_collapse(grp))) continue;
+      const std::int64_t dc = st.delta_count(grp);
+      if (!in_band(st.count + dc)) continue;
+      if (count_term(st.count + dc) - count_term(st.count) + st.delta_rest(grp, params) < -eps) {
+        st.flip(grp, dc);
         ++stats.flips;
         improved = true;
       }
     }
     // Swaps: keep b (collapsed) and collapse a neighbour a (kept), evaluated as one move.
     for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
-      if (g.fixed[b] || y[b]) continue;
-      const std::int64_t db = delta_count(b);
-      const double rb = delta_rest(b);
+      if (g.fixed[b] || st.y[b]) continue;
+      const double rb = st.delta_rest(b, params);
       if (rb >= 0.0) continue;  // keeping b must pay for something besides the count
-      apply(b, db);
+      const std::int64_t before = st.count;
+      const std::int64_t db = st.delta_count(b);
+      st.flip(b, db);
       Index best_a = kInvalidIndex;
       std::int64_t best_da = 0;
       double best_gain = -eps;
       for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
         const Index a = adjacent[k];
-        if (g.fixed[a] || !y[a] || !may_collapse(a)) continue;
-        const std::int64_t da = delta_count(a);
-        if (std::abs(double(count + da) - n) > band) continue;
-        const double gain = count_term(count + da) - count_term(count - db) + rb + delta_rest(a);
+        if (g.fixed[a] || !st.y[a] || !st.may_collapse(a)) continue;
+        const std::int64_t da = st.delta_count(a);
+        if (!in_band(st.count + da)) continue;
+        const double gain = count_term(st.count + da) - count_term(before) + rb + st.delta_rest(a, params);
         if (gain < best_gain) {
           best_gain = gain;
           best_a = a;
@@ -922,16 +884,16 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
         }
       }
       if (best_a != kInvalidIndex) {
-        apply(best_a, best_da);
+        st.flip(best_a, best_da);
         ++stats.swaps;
         improved = true;
       } else {
-        apply(b, -db);  // undo
+        st.flip(b, -db);  // undo
       }
     }
   }
   stats.converged = !improved;
-  return y;
+  return std::move(st.y);
 }
 
 // Groups that share a face, as CSR.
@@ -977,7 +939,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   const FaceGroups fg = make_face_groups(mesh, conn, groups);
 
   Stopwatch greedy_clock;
-  const GreedyResult greedy = greedy_select(groups, gc, fg, result.input_tri_equivalent, target, params);
+  const GreedyResult greedy = greedy_select(groups, gc, fg, target, params);
   result.seconds_greedy = greedy_clock.seconds();
   result.greedy_predicted = greedy.count;
   const double lo = (1.0 - params.epsilon_n) * double(target);

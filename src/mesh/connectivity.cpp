@@ -125,13 +125,7 @@ FaceComponents face_components(const Connectivity& conn) {
       uf.unite(conn.corner_face[cs[0]], conn.corner_face[cs[i]]);
   }
   FaceComponents out;
-  out.face_component.assign(conn.num_faces, kInvalidIndex);
-  std::vector<Index> id_of_root(conn.num_faces, kInvalidIndex);
-  for (Index f = 0; f < conn.num_faces; ++f) {
-    const Index r = uf.find(f);
-    if (id_of_root[r] == kInvalidIndex) id_of_root[r] = out.count++;
-    out.face_component[f] = id_of_root[r];
-  }
+  out.face_component = uf.dense_labels(out.count);
   return out;
 }
 

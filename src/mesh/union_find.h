@@ -33,6 +33,17 @@ class UnionFind {
     return a;
   }
   Index set_size(Index x) { return size_[find(x)]; }
+  /// A label 0..count-1 per element, numbering the sets in order of their first element.
+  std::vector<Index> dense_labels(Index& count) {
+    std::vector<Index> label(parent_.size()), of_root(parent_.size(), kInvalidIndex);
+    count = 0;
+    for (Index x = 0; x < size(); ++x) {
+      const Index r = find(x);
+      if (of_root[r] == kInvalidIndex) of_root[r] = count++;
+      label[x] = of_root[r];
+    }
+    return label;
+  }
   Index size() const { return static_cast<Index>(parent_.size()); }
 
  private:
