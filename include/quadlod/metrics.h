@@ -33,9 +33,8 @@ struct EvalParams {
   /// Flow deviation only compares an output quad with an input quad whose planes are within
   /// this angle (unoriented normals); beyond it the sample does not count as covered.
   double flow_max_normal_angle_deg = 60.0;
-  /// §6b: how much farther (normalised units, i.e. a fraction of the input's longest side) the
-  /// nearest input surface facing the output face's way may be than the nearest input surface
-  /// before the face counts as flipped. Absorbs two-sided input parts thinner than this.
+  /// §6b: slack (normalised units, a fraction of the input's longest side) added to twice the
+  /// distance of the nearest input surface before a face counts as flipped.
   double flip_tolerance = 1e-3;
   /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
   /// Results do not depend on it.
@@ -95,8 +94,8 @@ struct EvalResult {
 
   // --- orientation (beyond the paper; validity) ---------------------------------------------------
   /// Output faces that face away from the input surface they lie on: the nearest input surface
-  /// with the face's orientation (normals within 90°) is more than EvalParams::flip_tolerance
-  /// farther from the face's centroid than the nearest input surface (docs/metrics.md §6b).
+  /// with the face's orientation (normals within 90°) is more than twice as far from the face's
+  /// centroid as the nearest input surface, plus EvalParams::flip_tolerance (docs/metrics.md §6b).
   std::uint64_t flipped_faces = 0;
 
   // --- provenance -----------------------------------------------------------------------------------

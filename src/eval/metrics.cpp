@@ -389,8 +389,8 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
   r.seconds_distance = seconds_since(t_dist);
 
   // §6b orientation: an output face is flipped when the nearest input surface that faces its way
-  // is more than flip_tolerance farther than the nearest input surface (coincident two-sided
-  // input geometry is therefore not a flip).
+  // is more than twice as far (plus flip_tolerance) as the nearest input surface: coincident
+  // two-sided input and faces lying between two close sheets are not counted.
   {
     std::vector<Vec3> normal_in(soup_in.triangles.size());
     for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
@@ -405,7 +405,7 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
       if (any.primitive == kInvalidIndex) continue;
       const NearestHit agreeing = bvh_in.nearest_if(c, [&](Index t) { return normal_in[t].dot(n_out) >= 0.0; });
       if (agreeing.primitive == kInvalidIndex ||
-          std::sqrt(agreeing.distance_sq) > std::sqrt(any.distance_sq) + params.flip_tolerance)
+          std::sqrt(agreeing.distance_sq) > 2.0 * std::sqrt(any.distance_sq) + params.flip_tolerance)
         ++r.flipped_faces;
     }
   }
