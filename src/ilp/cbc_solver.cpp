@@ -365,7 +365,7 @@ struct Packer {
   void put(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
   void put_doubles(const std::vector<double>& v) {
     put<std::uint64_t>(v.size());
-    bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
+    if (!v.empty()) bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
   }
   void put_string(const std::string& s) {
     put<std::uint64_t>(s.size());
@@ -389,14 +389,14 @@ struct Unpacker {
     const auto n = get<std::uint64_t>();
     if (!ok || static_cast<std::uint64_t>(end - p) / sizeof(double) < n) { ok = false; return {}; }
     std::vector<double> v(n);
-    std::memcpy(v.data(), p, n * sizeof(double));
+    if (n > 0) std::memcpy(v.data(), p, n * sizeof(double));  // data() of an empty vector may be null
     p += n * sizeof(double);
     return v;
   }
   std::string get_string() {
     const auto n = get<std::uint64_t>();
     if (!ok || static_cast<std::uint64_t>(end - p) < n) { ok = false; return {}; }
-    std::string s(p, n);
+    std::string s(n > 0 ? std::string(p, n) : std::string());
     p += n;
     return s;
   }
