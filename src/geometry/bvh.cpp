@@ -287,31 +287,7 @@ TriangleBvh::TriangleBvh(std::span<const std::array<Vec3, 3>> triangles, const B
 }
 
 NearestHit TriangleBvh::nearest(const Vec3& p, Index hint) const {
-  NearestHit hit;
-  Index best = kInvalidIndex;
-  Vec3 best_point = Vec3::Zero();
-  double best_d2 = std::numeric_limits<double>::infinity();
-  if (hint < pos_.size()) {
-    const TrianglePoint tp = closest_point_on_triangle(frames_[pos_[hint]], p);
-    best_d2 = tp.distance_sq;
-    best = pos_[hint];
-    best_point = tp.point;
-  }
-  bvh_.nearest(p, best_d2, [&](Index i, double) {
-    const TrianglePoint tp = closest_point_on_triangle(frames_[i], p);
-    if (tp.distance_sq < best_d2) {
-      best_d2 = tp.distance_sq;
-      best = i;
-      best_point = tp.point;
-    }
-    return tp.distance_sq;
-  });
-  if (best != kInvalidIndex) {
-    hit.distance_sq = best_d2;
-    hit.point = best_point;
-    hit.primitive = ids_[best];
-  }
-  return hit;
+  return nearest_if(p, [](Index) { return true; }, hint);
 }
 
 SegmentBvh::SegmentBvh(std::span<const std::array<Vec3, 2>> segments, const BvhBuildParams& params) {

@@ -190,19 +190,23 @@ class TriangleBvh {
   /// seeds the search with that triangle's distance — typically the answer of a nearby query —
   /// which prunes more; the distance found does not depend on it (ties may pick another id).
   NearestHit nearest(const Vec3& p, Index hint = kInvalidIndex) const;
-  /// The same among the triangles whose id passes `accept` (a predicate on the original id).
+  /// The same among the triangles whose id passes `accept` (a predicate on the original id);
+  /// `hint`, if it passes, seeds the search as for nearest().
   template <class Accept>
-  NearestHit nearest_if(const Vec3& p, Accept&& accept) const {
+  NearestHit nearest_if(const Vec3& p, Accept&& accept, Index hint = kInvalidIndex) const {
     NearestHit hit;
     double best_d2 = std::numeric_limits<double>::infinity();
-    bvh_.nearest(p, best_d2, [&](Index i, double) {
-      if (!accept(ids_[i])) return std::numeric_limits<double>::infinity();
+    auto consider = [&](Index i) {
       const TrianglePoint tp = closest_point_on_triangle(frames_[i], p);
       if (tp.distance_sq < best_d2) {
         best_d2 = tp.distance_sq;
         hit = {tp.distance_sq, tp.point, ids_[i]};
       }
       return tp.distance_sq;
+    };
+    if (hint < pos_.size() && accept(hint)) consider(pos_[hint]);
+    bvh_.nearest(p, best_d2, [&](Index i, double) {
+      return accept(ids_[i]) ? consider(i) : std::numeric_limits<double>::infinity();
     });
     return hit;
   }

@@ -62,6 +62,16 @@ void append_number(std::string& s, double x) {
   s.append(buf, static_cast<std::size_t>(n));
 }
 
+// "x y z\n"
+void append_point(std::string& s, const Vec3& p) {
+  append_number(s, p.x());
+  s += ' ';
+  append_number(s, p.y());
+  s += ' ';
+  append_number(s, p.z());
+  s += '\n';
+}
+
 std::string format_edge_ply(const PolyMesh& mesh, const Connectivity& conn, const EdgeLayer& layer) {
   std::string s;
   s.reserve(64 * (mesh.positions.size() + layer.items.size()) + 256);
@@ -72,12 +82,7 @@ std::string format_edge_ply(const PolyMesh& mesh, const Connectivity& conn, cons
   s += "property int vertex1\nproperty int vertex2\n";
   s += "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
   for (const Vec3& p : mesh.positions) {
-    append_number(s, p.x());
-    s += ' ';
-    append_number(s, p.y());
-    s += ' ';
-    append_number(s, p.z());
-    s += '\n';
+    append_point(s, p);
   }
   for (const auto& [id, e] : layer.items) {
     const Rgb c = palette(id);
@@ -93,12 +98,7 @@ std::string format_edge_obj(const PolyMesh& mesh, const Connectivity& conn, cons
   s += "# quadlod analysis export: " + layer.name + " (polylines grouped by " + layer.group + "_N)\n";
   for (const Vec3& p : mesh.positions) {
     s += "v ";
-    append_number(s, p.x());
-    s += ' ';
-    append_number(s, p.y());
-    s += ' ';
-    append_number(s, p.z());
-    s += '\n';
+    append_point(s, p);
   }
   Index current = kInvalidIndex;
   for (const auto& [id, e] : layer.items) {
