@@ -63,17 +63,18 @@ inline std::string read_bytes(const fs::path& path) {
 /// n × m quads in the z = 0 plane with a per-corner UV lattice (shared UVs, no seams).
 inline PolyMesh quad_grid(Index n, Index m) {
   PolyMesh mesh;
+  mesh.uv_sets.resize(1);
   for (Index j = 0; j <= m; ++j)
     for (Index i = 0; i <= n; ++i) {
       mesh.positions.emplace_back(0.1 * i, 0.1 * j, 0.0);
-      mesh.uvs.emplace_back(double(i) / n, double(j) / m);
+      mesh.uv_sets[0].values.emplace_back(double(i) / n, double(j) / m);
     }
   const auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
   for (Index j = 0; j < m; ++j)
     for (Index i = 0; i < n; ++i) {
       for (const Index v : {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)}) {
         mesh.corner_vertex.push_back(v);
-        mesh.corner_uv.push_back(v);
+        mesh.uv_sets[0].corner.push_back(v);
       }
       mesh.face_offsets.push_back(mesh.num_corners());
     }
@@ -99,8 +100,13 @@ inline std::string mesh_difference(const PolyMesh& a, const PolyMesh& b) {
   vec("vertex_colors", a.vertex_colors, b.vertex_colors);
   vec("face_offsets", a.face_offsets, b.face_offsets);
   vec("corner_vertex", a.corner_vertex, b.corner_vertex);
-  vec("uvs", a.uvs, b.uvs);
-  vec("corner_uv", a.corner_uv, b.corner_uv);
+  if (d.str().empty() && a.uv_sets.size() != b.uv_sets.size())
+    d << "uv_sets: " << a.uv_sets.size() << " vs " << b.uv_sets.size();
+  for (std::size_t k = 0; k < a.uv_sets.size() && k < b.uv_sets.size(); ++k) {
+    vec("uv name", a.uv_sets[k].name, b.uv_sets[k].name);
+    vec("uv values", a.uv_sets[k].values, b.uv_sets[k].values);
+    vec("uv corner", a.uv_sets[k].corner, b.uv_sets[k].corner);
+  }
   vec("normals", a.normals, b.normals);
   vec("corner_normal", a.corner_normal, b.corner_normal);
   vec("face_object", a.face_object, b.face_object);

@@ -82,7 +82,12 @@ void expect_valid_output(const PolyMesh& in, const ClusterCollapseResult& r) {
   }
   // Each surviving corner keeps a UV of one of the input corners at a vertex that maps to it
   // (generators give corner_uv[c] == some lattice index; here only: indices stay in the pool).
-  ASSERT_EQ(r.mesh.uvs.size(), in.uvs.size());
+  ASSERT_EQ(r.mesh.uv_sets.size(), in.uv_sets.size());
+  for (std::size_t k = 0; k < in.uv_sets.size(); ++k) {
+    ASSERT_EQ(r.mesh.uv_sets[k].corner.size(), r.mesh.num_corners());
+    for (Index t : r.mesh.uv_sets[k].corner)
+      EXPECT_TRUE(t == kInvalidIndex || t < r.mesh.uv_sets[k].values.size());
+  }
 }
 
 // --- known answers -------------------------------------------------------------------------------
@@ -99,8 +104,8 @@ TEST(ClusterCollapse, NothingCollapsedIsIdentity) {
   EXPECT_EQ(r.mesh.positions, in.positions);
   EXPECT_EQ(r.mesh.face_offsets, in.face_offsets);
   EXPECT_EQ(r.mesh.corner_vertex, in.corner_vertex);
-  EXPECT_EQ(r.mesh.corner_uv, in.corner_uv);
-  EXPECT_EQ(r.mesh.uvs, in.uvs);
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, in.uv_sets[0].corner);
+  EXPECT_EQ(r.mesh.uv_sets[0].values, in.uv_sets[0].values);
   EXPECT_EQ(r.mesh.face_material, in.face_material);
   EXPECT_EQ(r.mesh.material_names, in.material_names);
   for (Index v = 0; v < in.num_vertices(); ++v) EXPECT_EQ(r.vertex_map[v], v);
@@ -153,7 +158,7 @@ TEST(ClusterCollapse, GridColumnChordRemovesOneColumn) {
   }
   // Surviving corners keep their own UV (grid: uv index == input vertex id).
   for (Index c = 0; c < r.mesh.num_corners(); ++c)
-    EXPECT_EQ(r.vertex_map[r.mesh.corner_uv[c]], r.mesh.corner_vertex[c]);
+    EXPECT_EQ(r.vertex_map[r.mesh.uv_sets[0].corner[c]], r.mesh.corner_vertex[c]);
 }
 
 TEST(ClusterCollapse, SingleEdgeBetweenTwoQuadsMakesTwoTriangles) {

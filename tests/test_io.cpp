@@ -43,7 +43,7 @@ TEST(ObjRead, PlainFaceFormKeepsQuadAndTriangle) {
   EXPECT_EQ(offsets(m), (std::vector<Index>{0, 4, 7}));
   EXPECT_EQ(corners(m), (std::vector<Index>{0, 1, 2, 3, 0, 2, 3}));
   EXPECT_EQ(m.positions[2], Vec3(1, 1, 0));
-  EXPECT_EQ(m.uvs.size(), 4u);      // pools are kept even when no face uses them
+  EXPECT_TRUE(m.uv_sets.empty());  // a `vt` pool no face uses is not a UV set
   EXPECT_EQ(m.normals.size(), 2u);
   EXPECT_FALSE(m.has_uvs());
   EXPECT_FALSE(m.has_normals());
@@ -55,7 +55,7 @@ TEST(ObjRead, PlainFaceFormKeepsQuadAndTriangle) {
 TEST(ObjRead, VertexTexcoordForm) {
   const ReadResult r = obj(std::string(kSquareVerts) + "f 1/4 2/3 3/2 4/1\n");
   ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_EQ(r.mesh.corner_uv, (std::vector<Index>{3, 2, 1, 0}));
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, (std::vector<Index>{3, 2, 1, 0}));
   EXPECT_FALSE(r.mesh.has_normals());
 }
 
@@ -69,7 +69,7 @@ TEST(ObjRead, VertexNormalForm) {
 TEST(ObjRead, VertexTexcoordNormalForm) {
   const ReadResult r = obj(std::string(kSquareVerts) + "f 1/1/1 2/2/1 3/3/2 4/4/2\n");
   ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_EQ(r.mesh.corner_uv, (std::vector<Index>{0, 1, 2, 3}));
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, (std::vector<Index>{0, 1, 2, 3}));
   EXPECT_EQ(r.mesh.corner_normal, (std::vector<Index>{0, 0, 1, 1}));
 }
 
@@ -77,7 +77,7 @@ TEST(ObjRead, CornersWithoutTexcoordGetInvalidIndex) {
   // The first face has no vt at all: its corners are back-filled when the array appears.
   const ReadResult r = obj(std::string(kSquareVerts) + "f 1 2 3\nf 1/1 3 4/4/\nf 2//1 3/2/ 4\n");
   ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_EQ(r.mesh.corner_uv, (std::vector<Index>{X, X, X, 0, X, 3, X, 1, X}));
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, (std::vector<Index>{X, X, X, 0, X, 3, X, 1, X}));
   EXPECT_EQ(r.mesh.corner_normal, (std::vector<Index>{X, X, X, X, X, X, 0, X, X}));
   EXPECT_EQ(r.mesh.check_layout(), "");
 }
@@ -90,7 +90,7 @@ TEST(ObjRead, NegativeIndicesAreRelativeToWhatIsDefinedSoFar) {
       "f -4/-1/-1 -2/-2/-1 -1/-1/-1\n");
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_EQ(corners(r.mesh), (std::vector<Index>{0, 1, 2, 0, 2, 3}));
-  EXPECT_EQ(r.mesh.corner_uv, (std::vector<Index>{0, 1, 2, 3, 2, 3}));
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, (std::vector<Index>{0, 1, 2, 3, 2, 3}));
   EXPECT_EQ(r.mesh.corner_normal, (std::vector<Index>{X, X, X, 0, 0, 0}));
 }
 
@@ -104,7 +104,7 @@ TEST(ObjRead, CrlfLineEnds) {
   const ReadResult r = obj("v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nvt 0.5 0.25\r\ng body\r\nf 1/1 2/1 3/1\r\n");
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_EQ(r.mesh.positions[1], Vec3(1, 0, 0));
-  EXPECT_EQ(r.mesh.uvs[0], Vec2(0.5, 0.25));
+  EXPECT_EQ(r.mesh.uv_sets[0].values[0], Vec2(0.5, 0.25));
   ASSERT_EQ(r.mesh.group_names.size(), 1u);
   EXPECT_EQ(r.mesh.group_names[0], "body");  // no '\r' in the name
 }
@@ -190,8 +190,8 @@ TEST(ObjRead, NumberForms) {
   ASSERT_TRUE(ok.ok()) << ok.error;
   EXPECT_EQ(ok.mesh.positions[0], Vec3(1.5, -2e-3, 0.25));
   EXPECT_EQ(ok.mesh.positions[1], Vec3(100, 0, 5));
-  EXPECT_EQ(ok.mesh.uvs[0], Vec2(0.5, 0));  // missing v defaults to 0
-  EXPECT_EQ(ok.mesh.uvs[1], Vec2(1, 2));    // w dropped
+  EXPECT_EQ(ok.mesh.uv_sets[0].values[0], Vec2(0.5, 0));  // missing v defaults to 0
+  EXPECT_EQ(ok.mesh.uv_sets[0].values[1], Vec2(1, 2));    // w dropped
 }
 
 TEST(ObjRead, IgnoredStatementsAreSkippedAndCounted) {
@@ -307,7 +307,7 @@ TEST(ObjRoundTrip, FullPrecisionDoublesWithSeventeenDigits) {
   std::uniform_real_distribution<double> u(-1e3, 1e3);
   PolyMesh m = quad_grid(6, 5);
   for (Vec3& p : m.positions) p = Vec3(u(rng), u(rng), u(rng) * 1e-9);
-  for (Vec2& t : m.uvs) t = Vec2(u(rng), u(rng));
+  for (Vec2& t : m.uv_sets[0].values) t = Vec2(u(rng), u(rng));
   WriteOptions o;
   o.precision = 17;
   TempDir dir;
@@ -396,10 +396,10 @@ PolyMesh ply_test_mesh() {
   m.positions.emplace_back(0.123456789012, -7.5, 1e-3);  // not float-exact
   const Index extra = m.num_vertices() - 1;
   m.add_face({0, extra, 4, 5, 1});
-  m.uvs.emplace_back(0.3, 0.7);
+  m.uv_sets[0].values.emplace_back(0.3, 0.7);
   for (Index c = m.face_begin(m.num_faces() - 1); c < m.num_corners(); ++c)
-    m.corner_uv[c] = static_cast<Index>(m.uvs.size() - 1);  // seam: vertex 0 has two UVs
-  m.corner_uv[m.num_corners() - 2] = kInvalidIndex;         // partial face
+    m.uv_sets[0].corner[c] = static_cast<Index>(m.uv_sets[0].values.size() - 1);  // seam: vertex 0 has two UVs
+  m.uv_sets[0].corner[m.num_corners() - 2] = kInvalidIndex;         // partial face
   for (Index v = 0; v < m.num_vertices(); ++v) {
     m.vertex_colors.emplace_back(v / 255.0, 1.0, 0.0);
     m.normals.push_back(Vec3(v, 1, 2).normalized());
@@ -430,9 +430,9 @@ void expect_same_after_ply(const PolyMesh& a, const PolyMesh& b) {
   EXPECT_EQ(a.corner_vertex, b.corner_vertex);
   ASSERT_TRUE(b.has_uvs());
   for (Index c = 0; c < a.num_corners(); ++c) {
-    const Index ta = a.corner_uv[c], tb = b.corner_uv[c];
+    const Index ta = a.uv_sets[0].corner[c], tb = b.uv_sets[0].corner[c];
     ASSERT_EQ(ta == kInvalidIndex, tb == kInvalidIndex) << "corner " << c;
-    if (ta != kInvalidIndex) EXPECT_TRUE(float_equal(a.uvs[ta], b.uvs[tb])) << "corner " << c;
+    if (ta != kInvalidIndex) EXPECT_TRUE(float_equal(a.uv_sets[0].values[ta], b.uv_sets[0].values[tb])) << "corner " << c;
   }
   ASSERT_TRUE(b.has_normals());
   EXPECT_EQ(b.corner_normal, b.corner_vertex);
@@ -509,7 +509,46 @@ TEST_P(PlyRoundTrip, CorpusDuck) {
   for (Index v = 0; v < a.mesh.num_vertices(); ++v)
     ASSERT_TRUE(float_equal(a.mesh.positions[v], b.mesh.positions[v])) << "vertex " << v;
   for (Index c = 0; c < a.mesh.num_corners(); ++c)
-    ASSERT_TRUE(float_equal(a.mesh.uvs[a.mesh.corner_uv[c]], b.mesh.uvs[b.mesh.corner_uv[c]])) << "corner " << c;
+    ASSERT_TRUE(float_equal(a.mesh.uv_sets[0].values[a.mesh.uv_sets[0].corner[c]], b.mesh.uv_sets[0].values[b.mesh.uv_sets[0].corner[c]])) << "corner " << c;
+}
+
+TEST_P(PlyRoundTrip, SeveralUvSetsSurvive) {
+  PolyMesh m = quad_grid(3, 2);
+  UvSet& second = m.uv_sets.emplace_back();
+  second.name = "texcoord1";
+  for (Index c = 0; c < m.num_corners(); ++c) {
+    second.corner.push_back(c % 5 == 0 ? kInvalidIndex : static_cast<Index>(second.values.size()));
+    if (c % 5 != 0) second.values.emplace_back(0.25 * (c % 4), 0.5 * (c % 3));
+  }
+  TempDir dir;
+  WriteOptions o;
+  o.ply_encoding = GetParam();
+  ASSERT_TRUE(write_mesh(m, dir / "two.ply", o).ok());
+  const ReadResult r = read_mesh(dir / "two.ply");
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_EQ(r.mesh.uv_sets.size(), 2u);
+  EXPECT_EQ(r.mesh.uv_sets[1].name, "texcoord1");
+  for (std::size_t k = 0; k < 2; ++k)
+    for (Index c = 0; c < m.num_corners(); ++c) {
+      const Index ta = m.uv_sets[k].corner[c], tb = r.mesh.uv_sets[k].corner[c];
+      ASSERT_EQ(ta == kInvalidIndex, tb == kInvalidIndex) << "set " << k << " corner " << c;
+      if (ta != kInvalidIndex)
+        EXPECT_TRUE(float_equal(m.uv_sets[k].values[ta], r.mesh.uv_sets[k].values[tb])) << "set " << k << " corner " << c;
+    }
+}
+
+TEST(ObjWrite, FurtherUvSetsAreDroppedWithAWarning) {
+  PolyMesh m = quad_grid(2, 2);
+  m.uv_sets.push_back(m.uv_sets[0]);
+  TempDir dir;
+  const WriteResult w = write_mesh(m, dir / "one.obj");
+  ASSERT_TRUE(w.ok()) << w.error;
+  ASSERT_EQ(w.warnings.size(), 1u);
+  EXPECT_NE(w.warnings[0].find("1 further set"), std::string::npos) << w.warnings[0];
+  const ReadResult r = read_mesh(dir / "one.obj");
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.mesh.uv_sets.size(), 1u);
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, m.uv_sets[0].corner);
 }
 
 INSTANTIATE_TEST_SUITE_P(Encodings, PlyRoundTrip,
@@ -552,9 +591,9 @@ TEST(PlyRead, AsciiWithAliasesExtraElementsAndPerVertexAttributes) {
   EXPECT_EQ(m.positions, (std::vector<Vec3>{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}));
   EXPECT_EQ(m.face_offsets, (std::vector<Index>{0, 4, 7}));
   EXPECT_EQ(m.corner_vertex, (std::vector<Index>{0, 1, 2, 3, 0, 2, 3}));
-  EXPECT_EQ(m.corner_uv, m.corner_vertex);      // per-vertex UVs, indexed by vertex
+  EXPECT_EQ(m.uv_sets[0].corner, m.corner_vertex);      // per-vertex UVs, indexed by vertex
   EXPECT_EQ(m.corner_normal, m.corner_vertex);
-  EXPECT_EQ(m.uvs[2], Vec2(1, 1));
+  EXPECT_EQ(m.uv_sets[0].values[2], Vec2(1, 1));
   EXPECT_EQ(m.vertex_colors[1], Vec3(0, 1, 0));
   EXPECT_EQ(m.vertex_colors[3], Vec3(0.2, 0.2, 0.2));
 }
@@ -597,9 +636,9 @@ TEST(PlyRead, BinaryBigEndianWithDoublesAndSkippedLists) {
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_EQ(r.mesh.positions[2], Vec3(0, -3.5, 1e10));
   EXPECT_EQ(r.mesh.corner_vertex, (std::vector<Index>{2, 0, 1}));
-  EXPECT_EQ(r.mesh.corner_uv, (std::vector<Index>{0, 1, 2}));
-  EXPECT_EQ(r.mesh.uvs[0], Vec2(0.5, 0.25));
-  EXPECT_EQ(r.mesh.uvs[2], Vec2(1, 0));
+  EXPECT_EQ(r.mesh.uv_sets[0].corner, (std::vector<Index>{0, 1, 2}));
+  EXPECT_EQ(r.mesh.uv_sets[0].values[0], Vec2(0.5, 0.25));
+  EXPECT_EQ(r.mesh.uv_sets[0].values[2], Vec2(1, 0));
 }
 
 TEST(PlyRead, FacesBeforeVerticesAndTexcoordBeforeIndices) {
@@ -613,7 +652,7 @@ TEST(PlyRead, FacesBeforeVerticesAndTexcoordBeforeIndices) {
   const ReadResult r = io_detail::parse_ply(text, "o.ply");
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_EQ(r.mesh.corner_vertex, (std::vector<Index>{0, 1, 2}));
-  EXPECT_EQ(r.mesh.uvs[1], Vec2(1, 0));
+  EXPECT_EQ(r.mesh.uv_sets[0].values[1], Vec2(1, 0));
 }
 
 TEST(PlyWrite, PerCornerNormalsThatDisagreeAreNotWritten) {
@@ -654,8 +693,7 @@ TEST(OffRead, CommentsVariantsAndFaceColours) {
 TEST(OffRoundTrip, ExactWithSeventeenDigits) {
   PolyMesh m = quad_grid(4, 3);
   m.positions[5] = Vec3(1.0 / 3.0, -2.0 / 7.0, 1e-300);
-  m.corner_uv.clear();
-  m.uvs.clear();
+  m.uv_sets.clear();
   m.add_face({0, 6, 12, 7, 1});
   TempDir dir;
   WriteOptions o;

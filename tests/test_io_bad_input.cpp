@@ -28,7 +28,7 @@ const char* kTriangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 
 std::string binary_ply(Index n) {
   PolyMesh m = quad_grid(n, n);
-  m.corner_uv.clear();  // 12 bytes per vertex, 17 per quad
+  m.uv_sets.clear();  // 12 bytes per vertex, 17 per quad
   std::string out, error;
   EXPECT_TRUE(io_detail::format_ply(m, {}, out, error)) << error;
   return out;

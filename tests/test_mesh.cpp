@@ -38,17 +38,18 @@ MeshStats stats_of(const PolyMesh& mesh) { return compute_stats(mesh, build_conn
 TEST(MeshKernel, AddFaceKeepsAttributeArraysAligned) {
   PolyMesh m;
   for (int i = 0; i < 4; ++i) m.add_vertex(Vec3(i, i * i, 0));
-  m.corner_uv.clear();
+  m.uv_sets.clear();
   m.face_material.clear();
   m.add_face({0, 1, 2});
-  m.uvs.emplace_back(0.5, 0.5);
-  m.corner_uv.assign(3, 0);
+  m.uv_sets.resize(1);
+  m.uv_sets[0].values.emplace_back(0.5, 0.5);
+  m.uv_sets[0].corner.assign(3, 0);
   m.material_names = {"steel"};
   m.face_material = {0};
   m.add_face({0, 2, 3});
   EXPECT_EQ(m.num_faces(), 2u);
-  EXPECT_EQ(m.corner_uv.size(), 6u);
-  EXPECT_EQ(m.corner_uv[5], kInvalidIndex);
+  EXPECT_EQ(m.uv_sets[0].corner.size(), 6u);
+  EXPECT_EQ(m.uv_sets[0].corner[5], kInvalidIndex);
   EXPECT_EQ(m.face_material[1], kInvalidIndex);
   EXPECT_EQ(m.check_layout(), "");
 }
@@ -62,7 +63,8 @@ TEST(MeshKernel, CheckLayoutNamesTheBadElement) {
   m.corner_vertex[2] = 7;
   EXPECT_NE(m.check_layout().find("corner 2"), std::string::npos);
   m.corner_vertex[2] = 2;
-  m.corner_uv = {0, 0, 0};
+  m.uv_sets.resize(1);
+  m.uv_sets[0].corner = {0, 0, 0};
   EXPECT_NE(m.check_layout().find("uv"), std::string::npos);
 }
 

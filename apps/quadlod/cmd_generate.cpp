@@ -44,6 +44,7 @@ Command add_generate(CLI::App& app, const GlobalOptions& global) {
             else mesh = make_cube(pick(opt->n, 8));
             const WriteResult written = write_mesh(mesh, opt->output);
             if (!written.ok()) return fail(written.error);
+            for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             if (!global.quiet)
               std::fprintf(stderr, "generate: %s with %u vertices, %u faces -> %s\n", opt->kind.c_str(),
                            mesh.num_vertices(), mesh.num_faces(), opt->output.c_str());

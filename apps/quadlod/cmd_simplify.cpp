@@ -104,6 +104,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             clock = Stopwatch();
             const WriteResult written = write_mesh(r.mesh, opt->output);
             if (!written.ok()) return fail(written.error);
+            for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             const double write_seconds = clock.seconds();
             r.report["input"] = opt->input;
             r.report["output"] = opt->output;

@@ -25,11 +25,12 @@ constexpr Index kGrid = 1000;
 PolyMesh make_grid(Index n) {
   PolyMesh m;
   m.positions.reserve((n + 1) * (n + 1));
-  m.uvs.reserve((n + 1) * (n + 1));
+  UvSet& uv = m.uv_sets.emplace_back();
+  uv.values.reserve((n + 1) * (n + 1));
   for (Index j = 0; j <= n; ++j)
     for (Index i = 0; i <= n; ++i) {
       m.positions.emplace_back(0.001 * i + 0.5, 0.25 * std::sin(0.01 * i) - 0.3, 0.001 * j - 1.25);
-      m.uvs.emplace_back(double(i) / n, double(j) / n);
+      uv.values.emplace_back(double(i) / n, double(j) / n);
     }
   m.face_offsets.reserve(std::size_t{n} * n + 1);
   m.corner_vertex.reserve(4ull * n * n);
@@ -39,7 +40,7 @@ PolyMesh make_grid(Index n) {
       for (const Index v : {a, a + 1, a + n + 2, a + n + 1}) m.corner_vertex.push_back(v);
       m.face_offsets.push_back(m.num_corners());
     }
-  m.corner_uv = m.corner_vertex;
+  uv.corner = m.corner_vertex;
   return m;
 }
 

@@ -41,6 +41,9 @@ struct WriteOptions {
 
 struct WriteResult {
   std::string error;  ///< empty on success
+  /// What the format could not hold and was dropped (e.g. UV sets beyond the first in OBJ);
+  /// the CLI prints them. Empty when everything was written.
+  std::vector<std::string> warnings;
   bool ok() const { return error.empty(); }
 };
 
@@ -54,12 +57,14 @@ bool format_from_path(const std::filesystem::path& path, MeshFormat& format);
 ///
 /// What each format fills in:
 ///   * OBJ: positions, vertex_colors (`v x y z r g b`), the uv/normal pools and per-corner
-///     indices exactly as the `f` records give them, o/g/usemtl/s tags and mtllib lines. The
-///     per-corner and per-face arrays exist only if the file uses them (has_uvs() is meaningful).
+///     indices exactly as the `f` records give them (one UV set, uv_sets[0], present only when a
+///     face uses `vt`), o/g/usemtl/s tags and mtllib lines. The per-corner and per-face arrays
+///     exist only if the file uses them (has_uvs() is meaningful).
 ///     Positive indices may refer forward; negative ones are relative to what precedes them.
 ///   * PLY: positions; per-vertex normals and UVs become pools indexed by the corner's vertex;
 ///     a per-face `texcoord` list (MeshLab, 2 floats per corner) becomes one pool entry per
-///     corner and wins over per-vertex UVs; red/green/blue become vertex_colors in [0,1].
+///     corner and wins over per-vertex UVs; lists `texcoord1`, `texcoord2`, … become further UV
+///     sets; red/green/blue become vertex_colors in [0,1].
 ///   * OFF: positions and faces (ST/C/N/4 variants are read, their extra values skipped).
 ReadResult read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 ReadResult read_obj(const std::filesystem::path& path, const ReadOptions& options = {});
@@ -77,8 +82,10 @@ ReadResult parse_obj(std::string_view text, const std::string& name, const ReadO
 ///
 ///   * OBJ: read → write → read reproduces the PolyMesh exactly when `precision` covers the
 ///     input's digits (17 always does); tags are emitted where they change between faces.
+///     OBJ has one UV set: further sets are dropped with a warning.
 ///   * PLY: float x y z (so coordinates round to float), nx ny nz only when every vertex has one
-///     normal shared by all its corners, uchar colours, per-corner UVs as a `texcoord` list.
+///     normal shared by all its corners, uchar colours, per-corner UVs as a `texcoord` list per
+///     UV set (`texcoord`, `texcoord1`, …; set names are not kept).
 ///     Face tags have no PLY form and are dropped.
 ///   * OFF: positions and faces only.
 WriteResult write_mesh(const PolyMesh& mesh, const std::filesystem::path& path,

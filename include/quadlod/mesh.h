@@ -4,9 +4,9 @@
 //   * vertices are rows of `positions`;
 //   * faces are stored as CSR: face f owns the corners [face_offsets[f], face_offsets[f+1]),
 //     listed counter-clockwise as read from the file; `corner_vertex[c]` is the vertex of corner c;
-//   * attributes are parallel arrays. Per-corner attributes (UV, normal) are OBJ-style:
-//     a pool of values plus one pool index per corner, so seams and shared values survive a
-//     read/write round trip unchanged;
+//   * attributes are parallel arrays. Per-corner attributes (any number of UV sets, normals) are
+//     OBJ-style: a pool of values plus one pool index per corner, so seams and shared values
+//     survive a read/write round trip unchanged;
 //   * per-face tags (object, group, material, smoothing group) index name tables.
 // Connectivity (edges, adjacency, boundary loops, components) is derived data and lives in
 // src/mesh/connectivity.h; nothing here caches it, so a PolyMesh can be edited freely.
@@ -46,14 +46,22 @@ struct BoundingBox {
   double longest_side() const { return extent().maxCoeff(); }
 };
 
+/// One UV set (texture coordinate layer): a pool of values plus one pool index per corner.
+/// uv_sets[0] is what OBJ `vt` reads and writes; PLY names the sets `texcoord`, `texcoord1`, …
+struct UvSet {
+  std::string name;            ///< layer name ("" when the file gives none)
+  std::vector<Vec2> values;    ///< the pool
+  std::vector<Index> corner;   ///< per corner: pool index or kInvalidIndex
+};
+
 /// A polygon mesh with optional per-corner UVs and normals and per-face tags.
 ///
 /// Invariants (checked by `check_layout()`):
 ///   * face_offsets.size() == num_faces() + 1, face_offsets[0] == 0, non-decreasing,
 ///     face_offsets.back() == corner_vertex.size(); every face has >= 3 corners;
 ///   * every corner_vertex entry < num_vertices();
-///   * corner_uv / corner_normal are empty (attribute absent) or have one entry per corner,
-///     each < uvs.size() / normals.size() or kInvalidIndex (that corner has no value);
+///   * every UV set's `corner` has one entry per corner, each < values.size() or kInvalidIndex
+///     (that corner has no UV in this set); corner_normal is empty (no normals) or likewise;
 ///   * face_object / face_group / face_material / face_smoothing are empty or one per face;
 ///     the first three index their name tables or are kInvalidIndex; smoothing 0 means "off";
 ///   * vertex_colors is empty or one per vertex.
@@ -67,8 +75,7 @@ struct PolyMesh {
   std::vector<Index> corner_vertex;
 
   // --- per-corner attributes (pool + per-corner index) ------------------------------------
-  std::vector<Vec2> uvs;
-  std::vector<Index> corner_uv;
+  std::vector<UvSet> uv_sets;  ///< empty when the mesh has no UVs; each set covers every corner
   std::vector<Vec3> normals;
   std::vector<Index> corner_normal;
 
@@ -98,7 +105,7 @@ struct PolyMesh {
   Index next_corner(Index f, Index c) const { return c + 1 == face_end(f) ? face_begin(f) : c + 1; }
   Index prev_corner(Index f, Index c) const { return c == face_begin(f) ? face_end(f) - 1 : c - 1; }
 
-  bool has_uvs() const { return !corner_uv.empty(); }
+  bool has_uvs() const { return !uv_sets.empty(); }
   bool has_normals() const { return !corner_normal.empty(); }
 
   // --- building ---------------------------------------------------------------------------------

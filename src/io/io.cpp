@@ -151,7 +151,7 @@ ReadResult read_mesh(const fs::path& path, const ReadOptions& options) {
 
 WriteResult write_mesh(const PolyMesh& mesh, const fs::path& path, const WriteOptions& options) {
   MeshFormat format{};
-  if (!format_from_path(path, format)) return {"cannot write " + unknown_format_error(path)};
+  if (!format_from_path(path, format)) return {"cannot write " + unknown_format_error(path), {}};
   switch (format) {
     case MeshFormat::Obj: return write_obj(mesh, path, options);
     case MeshFormat::Ply: return write_ply(mesh, path, options);
@@ -162,7 +162,7 @@ WriteResult write_mesh(const PolyMesh& mesh, const fs::path& path, const WriteOp
 
 WriteResult write_file_atomically(const fs::path& path, std::string_view contents) {
   const std::string shown = path.string();
-  const auto fail = [&](const std::string& why) { return WriteResult{"cannot write " + shown + ": " + why}; };
+  const auto fail = [&](const std::string& why) { return WriteResult{"cannot write " + shown + ": " + why, {}}; };
   if (!path.has_filename()) return fail("not a file name");
 
   const fs::path dir = path.parent_path();

@@ -73,7 +73,7 @@ template <class Format>
 WriteResult format_and_write(const PolyMesh& mesh, const std::filesystem::path& path,
                              const WriteOptions& options, Format format) {
   std::string out, error;
-  if (!format(mesh, options, out, error)) return {"cannot write " + path.string() + ": " + error};
+  if (!format(mesh, options, out, error)) return {"cannot write " + path.string() + ": " + error, {}};
   return write_file_atomically(path, out);
 }
 

@@ -109,6 +109,7 @@ class ObjParser {
   bool smoothing_seen_ = false;
   Index smoothing_ = 0;
   std::vector<ForwardReference> forward_;
+  UvSet uv_;  // `vt` pool and per-corner indices; becomes uv_sets[0] when a face uses it
 };
 
 bool ObjParser::run() {
@@ -169,6 +170,12 @@ bool ObjParser::run() {
     result_.error = name_ + ": no faces";
     return false;
   }
+  // Corners after the last one with a value have none.
+  if (!uv_.corner.empty()) {
+    uv_.corner.resize(mesh_.num_corners(), kInvalidIndex);
+    mesh_.uv_sets.push_back(std::move(uv_));
+  }
+  if (!mesh_.corner_normal.empty()) mesh_.corner_normal.resize(mesh_.num_corners(), kInvalidIndex);
   return true;
 }
 
@@ -192,7 +199,7 @@ void ObjParser::reserve(const char* p, const char* end) {
     ++p;
   }
   mesh_.positions.reserve(v);
-  mesh_.uvs.reserve(vt);
+  uv_.values.reserve(vt);
   mesh_.normals.reserve(vn);
   mesh_.face_offsets.reserve(f + 1);
   // Quad-dominant input; a corner takes at least 2 bytes, which bounds what junk can reserve.
@@ -276,7 +283,7 @@ bool ObjParser::texcoord(const char* p, const char* end) {
   const int n = numbers(p, end, v, 3, "texture coordinate");
   if (n < 0) return false;
   if (n < 1) return fail("texture coordinate has no values");
-  mesh_.uvs.emplace_back(v[0], v[1]);  // w (3D textures) is dropped
+  uv_.values.emplace_back(v[0], v[1]);  // w (3D textures) is dropped
   return true;
 }
 
@@ -348,7 +355,7 @@ bool ObjParser::face(const char* p, const char* end) {
       ++p;
       if (p < end && *p != '/' && !is_blank(*p)) {
         if (!parse_int64(p, end, raw, p)) return bad_corner();
-        if (!resolve(raw, m.uvs.size(), "texture coordinate", vt, fwd.uv)) return false;
+        if (!resolve(raw, uv_.values.size(), "texture coordinate", vt, fwd.uv)) return false;
       }
       if (p < end && *p == '/') {
         ++p;
@@ -364,10 +371,10 @@ bool ObjParser::face(const char* p, const char* end) {
     // are back-filled with kInvalidIndex (resize is a no-op once the array has caught up).
     const std::size_t c = m.corner_vertex.size();
     m.corner_vertex.push_back(v);
-    if (vt != kInvalidIndex || !m.corner_uv.empty()) {
-      if (m.corner_uv.empty()) m.corner_uv.reserve(m.corner_vertex.capacity());
-      m.corner_uv.resize(c, kInvalidIndex);
-      m.corner_uv.push_back(vt);
+    if (vt != kInvalidIndex || !uv_.corner.empty()) {
+      if (uv_.corner.empty()) uv_.corner.reserve(m.corner_vertex.capacity());
+      uv_.corner.resize(c, kInvalidIndex);
+      uv_.corner.push_back(vt);
     }
     if (vn != kInvalidIndex || !m.corner_normal.empty()) {
       if (m.corner_normal.empty()) m.corner_normal.reserve(m.corner_vertex.capacity());
@@ -405,7 +412,7 @@ bool ObjParser::check_forward_references() {
   for (const ForwardReference& r : forward_) {
     line_ = r.line;
     if (!check(r.vertex, mesh_.positions.size(), "vertex") ||
-        !check(r.uv, mesh_.uvs.size(), "texture coordinate") ||
+        !check(r.uv, uv_.values.size(), "texture coordinate") ||
         !check(r.normal, mesh_.normals.size(), "normal"))
       return false;
   }
@@ -454,7 +461,7 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
   const bool colors = !mesh.vertex_colors.empty();
   out.clear();
   out.reserve(mesh.positions.size() * (colors ? 6 : 3) * (precision + 8) +
-              mesh.uvs.size() * 2 * (precision + 8) + mesh.normals.size() * 3 * (precision + 8) +
+              (mesh.has_uvs() ? mesh.uv_sets[0].values.size() : 0) * 2 * (precision + 8) + mesh.normals.size() * 3 * (precision + 8) +
               mesh.corner_vertex.size() * 24 + mesh.face_offsets.size() * 4 + 256);
 
   out += "# quadlod: ";
@@ -479,10 +486,12 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
     if (colors) append_vec("", mesh.vertex_colors[i].data(), 3);
     out += '\n';
   }
-  for (const Vec2& t : mesh.uvs) {
-    append_vec("vt", t.data(), 2);
-    out += '\n';
-  }
+  // OBJ has one texture-coordinate set; further sets need PLY (write_mesh warns).
+  if (mesh.has_uvs())
+    for (const Vec2& t : mesh.uv_sets[0].values) {
+      append_vec("vt", t.data(), 2);
+      out += '\n';
+    }
   for (const Vec3& n : mesh.normals) {
     append_vec("vn", n.data(), 3);
     out += '\n';
@@ -518,7 +527,7 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
     for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) {
       out += ' ';
       append_uint(out, std::uint64_t{mesh.corner_vertex[c]} + 1);
-      const Index t = uvs ? mesh.corner_uv[c] : kInvalidIndex;
+      const Index t = uvs ? mesh.uv_sets[0].corner[c] : kInvalidIndex;
       const Index n = normals ? mesh.corner_normal[c] : kInvalidIndex;
       if (t != kInvalidIndex) {
         out += '/';
@@ -538,7 +547,11 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
 
 WriteResult write_obj(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options) {
-  return format_and_write(mesh, path, options, format_obj);
+  WriteResult r = format_and_write(mesh, path, options, format_obj);
+  if (r.ok() && mesh.uv_sets.size() > 1)
+    r.warnings.push_back(path.string() + ": OBJ holds one UV set; " +
+                         std::to_string(mesh.uv_sets.size() - 1) + " further set(s) dropped (write PLY to keep them)");
+  return r;
 }
 
 }  // namespace quadlod

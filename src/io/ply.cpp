@@ -3,7 +3,8 @@
 // Reader: any element/property layout with the eight scalar types (and their int8/uint8/...
 // aliases). Used: `vertex` x y z, nx ny nz (per-vertex normals), s t | u v | texture_u
 // texture_v | texture_s texture_t (per-vertex UVs), red green blue; `face` vertex_indices (or
-// vertex_index) and MeshLab's per-face `texcoord` list (2 floats per corner). Per-vertex
+// vertex_index) and MeshLab's per-face `texcoord` list (2 floats per corner), plus further UV
+// sets as lists `texcoord1`, `texcoord2`, … (our extension, one UV set each). Per-vertex
 // attributes become per-corner pools indexed by the corner's vertex. Everything else, lists
 // included, is skipped. Counts in the header are never trusted for allocation: reservations are
 // capped by what the remaining bytes can hold, so a header claiming 4e9 vertices in a 100-byte
@@ -12,7 +13,8 @@
 // Writer: float x y z; nx ny nz when every vertex has one normal shared by all its corners
 // (per-corner normals have no portable PLY form and are otherwise dropped); uchar red green
 // blue; `list uchar int vertex_indices` (wider count type for faces over 255 corners) and, with
-// UVs, `list uchar float texcoord`. A face whose corners all lack UVs gets an empty texcoord list,
+// UVs, `list uchar float texcoord` (then `texcoord1`, … for further UV sets; set names other
+// than these are not kept). A face whose corners all lack UVs gets an empty texcoord list,
 // a partial one gets NaN pairs for the missing corners, which the reader maps back to "no UV".
 // Tags (o, g, usemtl, s) have no PLY form and are not written.
 #include "io/io_common.h"
@@ -233,7 +235,16 @@ class PlyParser {
   // Per-vertex attributes and per-corner texcoords, turned into pools by finish().
   std::vector<Vec3> vertex_normals_;
   std::vector<Vec2> vertex_uvs_;
-  std::vector<float> corner_texcoords_;  // 2 per corner; empty unless a face has a texcoord list
+  // One per face list `texcoord`, `texcoord1`, …: 2 floats per corner, NaN = no UV; `values`
+  // stays empty unless a face has a non-empty list.
+  struct TexcoordList {
+    int property = -1;
+    std::string name;
+    std::vector<float> values;
+    std::vector<float> face;  // the current face's list (may precede vertex_indices)
+    std::size_t count = 0;
+  };
+  std::vector<TexcoordList> corner_texcoords_;
   bool faces_seen_ = false;
 };
 
@@ -404,22 +415,29 @@ bool PlyParser::read_faces(Reader& reader, const PlyElement& e) {
   if (iv < 0) iv = e.find("vertex_index");
   if (iv < 0 || !e.properties[static_cast<std::size_t>(iv)].is_list)
     return fail("face element has no vertex_indices list");
-  int it = e.find("texcoord");
-  if (it >= 0 && !e.properties[static_cast<std::size_t>(it)].is_list) it = -1;
+  for (int set = 0;; ++set) {
+    const std::string name = set == 0 ? "texcoord" : "texcoord" + std::to_string(set);
+    const int it = e.find(name);
+    if (it < 0 || !e.properties[static_cast<std::size_t>(it)].is_list) break;
+    corner_texcoords_.push_back({it, name, {}, {}, 0});
+  }
   if (e.count >= kInvalidIndex) return fail("too many faces for 32-bit indices");
 
   PolyMesh& m = mesh_;
   const std::size_t expect = std::min<std::size_t>(e.count, reader.remaining() / e.min_bytes(encoding_ == PlyEncoding::Ascii));
   m.face_offsets.reserve(expect + 1);
   m.corner_vertex.reserve(expect * 4);  // quad-dominant input
-  std::vector<float> face_texcoords;    // reused: texcoord may precede vertex_indices
   std::vector<Index> scratch;
-  std::size_t texcoord_count = 0;
   double v = 0;
+  auto texcoord_list = [&](std::size_t k) -> TexcoordList* {
+    for (TexcoordList& t : corner_texcoords_)
+      if (t.property == static_cast<int>(k)) return &t;
+    return nullptr;
+  };
 
   for (std::uint64_t i = 0; i < e.count; ++i) {
     const std::size_t first = m.corner_vertex.size();
-    texcoord_count = 0;
+    for (TexcoordList& t : corner_texcoords_) t.count = 0;
     for (std::size_t k = 0; k < e.properties.size(); ++k) {
       const PlyProperty& p = e.properties[k];
       if (const Status s = reader.scalar(p.is_list ? p.count_type : p.type, v); s != Status::Ok)
@@ -438,15 +456,15 @@ bool PlyParser::read_faces(Reader& reader, const PlyElement& e) {
             return fail("face " + std::to_string(i) + ": bad vertex index " + std::to_string(v));
           m.corner_vertex.push_back(static_cast<Index>(v));
         }
-      } else if (static_cast<int>(k) == it) {
+      } else if (TexcoordList* t = texcoord_list(k)) {
         if (count > reader.remaining() / (encoding_ == PlyEncoding::Ascii ? 2 : type_size(p.type)))
           return value_error(reader, Status::Truncated, e, i);
-        face_texcoords.resize(count);
+        t->face.resize(count);
         for (std::uint64_t j = 0; j < count; ++j) {
           if (const Status s = reader.scalar(p.type, v); s != Status::Ok) return value_error(reader, s, e, i);
-          face_texcoords[j] = static_cast<float>(v);
+          t->face[j] = static_cast<float>(v);
         }
-        texcoord_count = count;
+        t->count = count;
       } else if (const Status s = reader.skip(p.type, count); s != Status::Ok) {
         return value_error(reader, s, e, i);
       }
@@ -458,14 +476,15 @@ bool PlyParser::read_faces(Reader& reader, const PlyElement& e) {
                                            options_.allow_repeated_vertex, scratch, repeated);
     if (problem != FaceProblem::None)
       return fail("face " + std::to_string(i) + ": " + describe_face_problem(problem, corners, repeated, 0));
-    if (texcoord_count != 0 && texcoord_count != 2 * corners)
-      return fail("face " + std::to_string(i) + ": texcoord list has " + std::to_string(texcoord_count) +
-                  " values for " + std::to_string(corners) + " corners");
-    if (texcoord_count != 0 || !corner_texcoords_.empty()) {
+    for (TexcoordList& t : corner_texcoords_) {
+      if (t.count != 0 && t.count != 2 * corners)
+        return fail("face " + std::to_string(i) + ": " + t.name + " list has " + std::to_string(t.count) +
+                    " values for " + std::to_string(corners) + " corners");
+      if (t.count == 0 && t.values.empty()) continue;
       // Corners before the first face with texcoords have none: NaN marks "no UV".
-      corner_texcoords_.resize(2 * first, std::numeric_limits<float>::quiet_NaN());
-      if (texcoord_count) corner_texcoords_.insert(corner_texcoords_.end(), face_texcoords.begin(), face_texcoords.begin() + texcoord_count);
-      else corner_texcoords_.resize(2 * (first + corners), std::numeric_limits<float>::quiet_NaN());
+      t.values.resize(2 * first, std::numeric_limits<float>::quiet_NaN());
+      if (t.count) t.values.insert(t.values.end(), t.face.begin(), t.face.begin() + t.count);
+      else t.values.resize(2 * (first + corners), std::numeric_limits<float>::quiet_NaN());
     }
     m.face_offsets.push_back(static_cast<Index>(m.corner_vertex.size()));
   }
@@ -494,20 +513,26 @@ bool PlyParser::finish() {
         return fail("face " + std::to_string(f) + ": vertex index " + std::to_string(m.corner_vertex[c]) +
                     " out of range (" + std::to_string(nv) + " vertices)");
 
-  if (!corner_texcoords_.empty()) {
-    // One pool entry per corner that has a UV: the PLY list carries no sharing to preserve.
-    m.uvs.reserve(m.num_corners());
-    m.corner_uv.assign(m.num_corners(), kInvalidIndex);
-    for (Index c = 0; c < m.num_corners(); ++c) {
-      const float u = corner_texcoords_[2 * c], v = corner_texcoords_[2 * c + 1];
-      if (!std::isfinite(u) || !std::isfinite(v)) continue;
-      m.corner_uv[c] = static_cast<Index>(m.uvs.size());
-      m.uvs.emplace_back(u, v);
+  // Per-corner lists win over per-vertex UVs for set 0. One pool entry per corner that has a
+  // UV: the PLY list carries no sharing to preserve.
+  for (TexcoordList& t : corner_texcoords_) {
+    if (t.values.empty()) {
+      if (m.uv_sets.empty() && !vertex_uvs_.empty()) m.uv_sets.push_back({"", std::move(vertex_uvs_), m.corner_vertex});
+      continue;
     }
-  } else if (!vertex_uvs_.empty()) {
-    m.uvs = std::move(vertex_uvs_);
-    m.corner_uv = m.corner_vertex;
+    t.values.resize(2 * std::size_t{m.num_corners()}, std::numeric_limits<float>::quiet_NaN());
+    UvSet& set = m.uv_sets.emplace_back();
+    set.name = t.name == "texcoord" ? "" : t.name;
+    set.values.reserve(m.num_corners());
+    set.corner.assign(m.num_corners(), kInvalidIndex);
+    for (Index c = 0; c < m.num_corners(); ++c) {
+      const float u = t.values[2 * c], v = t.values[2 * c + 1];
+      if (!std::isfinite(u) || !std::isfinite(v)) continue;
+      set.corner[c] = static_cast<Index>(set.values.size());
+      set.values.emplace_back(u, v);
+    }
   }
+  if (m.uv_sets.empty() && !vertex_uvs_.empty()) m.uv_sets.push_back({"", std::move(vertex_uvs_), m.corner_vertex});
   if (!vertex_normals_.empty()) {
     m.normals = std::move(vertex_normals_);
     m.corner_normal = m.corner_vertex;
@@ -641,7 +666,11 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
   append_uint(out, mesh.num_faces());
   out += wide_count ? "\nproperty list int " : "\nproperty list uchar ";
   out += uint_index ? "uint vertex_indices\n" : "int vertex_indices\n";
-  if (uvs) out += wide_texcoord_count ? "property list int float texcoord\n" : "property list uchar float texcoord\n";
+  for (std::size_t k = 0; k < mesh.uv_sets.size(); ++k) {
+    out += wide_texcoord_count ? "property list int float texcoord" : "property list uchar float texcoord";
+    if (k > 0) append_uint(out, k);
+    out += '\n';
+  }
   out += "end_header\n";
 
   const bool ascii = options.ply_encoding == PlyEncoding::Ascii;
@@ -665,17 +694,17 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
     if (wide_count) w.i32(n);
     else w.u8(static_cast<std::uint8_t>(n));
     for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) w.i32(mesh.corner_vertex[c]);
-    if (uvs) {
+    for (const UvSet& set : mesh.uv_sets) {
       Index with_uv = 0;
-      for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) with_uv += mesh.corner_uv[c] != kInvalidIndex;
+      for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) with_uv += set.corner[c] != kInvalidIndex;
       const Index count = with_uv == 0 ? 0 : 2 * n;
       if (wide_texcoord_count) w.i32(count);
       else w.u8(static_cast<std::uint8_t>(count));
       if (count)
         for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) {
-          const Index t = mesh.corner_uv[c];
-          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(mesh.uvs[t].x()));
-          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(mesh.uvs[t].y()));
+          const Index t = set.corner[c];
+          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(set.values[t].x()));
+          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(set.values[t].y()));
         }
     }
     w.end_record();

@@ -14,14 +14,15 @@ struct LatticeBuilder {
   Index uv_index(Index i, Index j) const { return j * uv_columns + i; }
   void quad(std::array<Index, 4> v, std::array<Index, 4> uv) {
     const Index f = mesh.add_face(std::span<const Index>(v.data(), 4));
-    for (Index k = 0; k < 4; ++k) mesh.corner_uv[mesh.face_begin(f) + k] = uv[k];
+    for (Index k = 0; k < 4; ++k) mesh.uv_sets[0].corner[mesh.face_begin(f) + k] = uv[k];
   }
 };
 
 void add_uv_lattice(PolyMesh& mesh, Index n, Index m) {
+  mesh.uv_sets.resize(1);
   for (Index j = 0; j <= m; ++j)
-    for (Index i = 0; i <= n; ++i) mesh.uvs.emplace_back(double(i) / n, double(j) / m);
-  mesh.corner_uv.reserve(4ull * n * m);
+    for (Index i = 0; i <= n; ++i) mesh.uv_sets[0].values.emplace_back(double(i) / n, double(j) / m);
+  mesh.uv_sets[0].corner.reserve(4ull * n * m);
 }
 
 
@@ -37,8 +38,7 @@ PolyMesh make_grid(Index n, Index m, double width, double height) {
     for (Index i = 0; i < n; ++i) {
       const std::array<Index, 4> v{id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)};
       const Index f = mesh.add_face(std::span<const Index>(v.data(), 4));
-      mesh.corner_uv.resize(mesh.num_corners());
-      for (Index k = 0; k < 4; ++k) mesh.corner_uv[mesh.face_begin(f) + k] = v[k];
+      for (Index k = 0; k < 4; ++k) mesh.uv_sets[0].corner[mesh.face_begin(f) + k] = v[k];
     }
   return mesh;
 }
@@ -57,7 +57,6 @@ PolyMesh make_torus(Index n, Index m, double major_radius, double minor_radius) 
   auto id = [&](Index i, Index j) { return (i % n) * m + (j % m); };
   for (Index i = 0; i < n; ++i)
     for (Index j = 0; j < m; ++j) {
-      mesh.corner_uv.resize(mesh.num_corners());
       // Outward: (u, v) increasing gives an outward normal with this vertex order.
       b.quad({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)},
              {b.uv_index(i, j), b.uv_index(i + 1, j), b.uv_index(i + 1, j + 1), b.uv_index(i, j + 1)});
@@ -78,7 +77,6 @@ PolyMesh make_cylinder(Index n, Index m, double radius, double height) {
   auto id = [&](Index i, Index j) { return j * n + (i % n); };
   for (Index j = 0; j < m; ++j)
     for (Index i = 0; i < n; ++i) {
-      mesh.corner_uv.resize(mesh.num_corners());
       b.quad({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)},
              {b.uv_index(i, j), b.uv_index(i + 1, j), b.uv_index(i + 1, j + 1), b.uv_index(i, j + 1)});
     }
@@ -113,8 +111,7 @@ PolyMesh make_cube(Index k, double size) {
           c[s.b] = v;
           return vertex(c[0], c[1], c[2]);
         };
-        mesh.corner_uv.resize(mesh.num_corners());
-        b.quad({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)},
+          b.quad({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)},
                {b.uv_index(i, j), b.uv_index(i + 1, j), b.uv_index(i + 1, j + 1), b.uv_index(i, j + 1)});
       }
   return mesh;
@@ -141,26 +138,26 @@ PolyMesh make_demo_vase(Index segments, Index rings) {
   auto id = [&](Index i, Index j) { return j * segments + (i % segments); };
 
   // UVs: the body is a cylindrical chart (with a seam at i = 0 / segments), the caps are discs.
+  mesh.uv_sets.resize(1);
   for (Index j = 0; j <= rings; ++j)
-    for (Index i = 0; i <= segments; ++i) mesh.uvs.emplace_back(double(i) / segments, 0.5 * j / rings);
-  const Index disc_base = static_cast<Index>(mesh.uvs.size());
+    for (Index i = 0; i <= segments; ++i) mesh.uv_sets[0].values.emplace_back(double(i) / segments, 0.5 * j / rings);
+  const Index disc_base = static_cast<Index>(mesh.uv_sets[0].values.size());
   for (Index i = 0; i < segments; ++i) {
     const double a = two_pi * i / segments;
-    mesh.uvs.emplace_back(0.25 + 0.2 * std::cos(a), 0.75 + 0.2 * std::sin(a));
+    mesh.uv_sets[0].values.emplace_back(0.25 + 0.2 * std::cos(a), 0.75 + 0.2 * std::sin(a));
   }
-  const Index pole_uv = static_cast<Index>(mesh.uvs.size());
-  mesh.uvs.emplace_back(0.25, 0.75);
-  const Index lid_base = static_cast<Index>(mesh.uvs.size());
+  const Index pole_uv = static_cast<Index>(mesh.uv_sets[0].values.size());
+  mesh.uv_sets[0].values.emplace_back(0.25, 0.75);
+  const Index lid_base = static_cast<Index>(mesh.uv_sets[0].values.size());
   for (Index i = 0; i < segments; ++i) {
     const double a = two_pi * i / segments;
-    mesh.uvs.emplace_back(0.75 + 0.2 * std::cos(a), 0.75 + 0.2 * std::sin(a));
+    mesh.uv_sets[0].values.emplace_back(0.75 + 0.2 * std::cos(a), 0.75 + 0.2 * std::sin(a));
   }
   auto body_uv = [&](Index i, Index j) { return j * (segments + 1) + i; };
 
   auto set_uvs = [&](Index f, std::initializer_list<Index> uv) {
-    mesh.corner_uv.resize(mesh.num_corners());
     Index c = mesh.face_begin(f);
-    for (Index u : uv) mesh.corner_uv[c++] = u;
+    for (Index u : uv) mesh.uv_sets[0].corner[c++] = u;
   };
   for (Index j = 0; j < rings; ++j)
     for (Index i = 0; i < segments; ++i)
@@ -177,8 +174,7 @@ PolyMesh make_demo_vase(Index segments, Index rings) {
     lid_uv[i] = lid_base + i;
   }
   const Index f = mesh.add_face(lid);
-  mesh.corner_uv.resize(mesh.num_corners());
-  std::copy(lid_uv.begin(), lid_uv.end(), mesh.corner_uv.begin() + mesh.face_begin(f));
+  std::copy(lid_uv.begin(), lid_uv.end(), mesh.uv_sets[0].corner.begin() + mesh.face_begin(f));
   return mesh;
 }
 

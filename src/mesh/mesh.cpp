@@ -9,7 +9,7 @@ Index PolyMesh::add_face(std::span<const Index> vertices) {
   const Index f = num_faces();
   corner_vertex.insert(corner_vertex.end(), vertices.begin(), vertices.end());
   face_offsets.push_back(static_cast<Index>(corner_vertex.size()));
-  if (has_uvs()) corner_uv.resize(corner_vertex.size(), kInvalidIndex);
+  for (UvSet& set : uv_sets) set.corner.resize(corner_vertex.size(), kInvalidIndex);
   if (has_normals()) corner_normal.resize(corner_vertex.size(), kInvalidIndex);
   if (!face_object.empty()) face_object.push_back(kInvalidIndex);
   if (!face_group.empty()) face_group.push_back(kInvalidIndex);
@@ -64,9 +64,17 @@ std::string PolyMesh::check_layout() const {
   if (!vertex_colors.empty() && vertex_colors.size() != positions.size())
     return "vertex colors: " + std::to_string(vertex_colors.size()) + " entries for " +
            std::to_string(positions.size()) + " vertices";
+  for (std::size_t k = 0; k < uv_sets.size(); ++k) {
+    const std::string what = "uv set " + std::to_string(k);
+    if (uv_sets[k].corner.size() != num_corners())
+      return what + ": " + std::to_string(uv_sets[k].corner.size()) + " entries for " +
+             std::to_string(num_corners()) + " corners";
+    if (std::string s = check_pool(uv_sets[k].corner, uv_sets[k].values.size(), num_corners(), what.c_str());
+        !s.empty())
+      return s;
+  }
   for (const std::string& s :
-       {check_pool(corner_uv, uvs.size(), num_corners(), "uv"),
-        check_pool(corner_normal, normals.size(), num_corners(), "normal"),
+       {check_pool(corner_normal, normals.size(), num_corners(), "normal"),
         check_tags(face_object, object_names.size(), num_faces(), "object", true),
         check_tags(face_group, group_names.size(), num_faces(), "group", true),
         check_tags(face_material, material_names.size(), num_faces(), "material", true),

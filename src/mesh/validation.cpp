@@ -86,10 +86,12 @@ MeshStats compute_stats(const PolyMesh& mesh, const Connectivity& conn,
   s.nonmanifold_vertices = static_cast<Index>(std::count(nm.begin(), nm.end(), true));
   s.components = face_components(conn).count;
 
+  s.uv_sets = static_cast<Index>(mesh.uv_sets.size());
   if (mesh.has_uvs()) {
-    const auto missing = std::count(mesh.corner_uv.begin(), mesh.corner_uv.end(), kInvalidIndex);
+    const auto& corner = mesh.uv_sets[0].corner;
+    const auto missing = std::count(corner.begin(), corner.end(), kInvalidIndex);
     s.has_uvs = missing == 0;
-    s.has_partial_uvs = missing > 0 && missing < static_cast<long>(mesh.corner_uv.size());
+    s.has_partial_uvs = missing > 0 && missing < static_cast<long>(corner.size());
   }
   return s;
 }
@@ -122,6 +124,7 @@ nlohmann::json to_json(const MeshStats& s) {
       {"components", s.components},
       {"nonfinite_vertices", s.nonfinite_vertices},
       {"has_uvs", s.has_uvs},
+      {"uv_sets", s.uv_sets},
       {"has_partial_uvs", s.has_partial_uvs},
       {"has_normals", s.has_normals},
       {"materials", s.materials},

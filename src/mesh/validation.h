@@ -36,7 +36,8 @@ struct MeshStats {
   Index duplicate_faces = 0;       ///< faces whose vertex set equals an earlier face's
   Index components = 0;            ///< face components through shared edges
   Index nonfinite_vertices = 0;    ///< vertices with a NaN or infinite coordinate
-  bool has_uvs = false;            ///< every corner has a UV
+  bool has_uvs = false;            ///< every corner has a UV in the first UV set
+  Index uv_sets = 0;               ///< number of UV sets (texture coordinate layers)
   bool has_partial_uvs = false;    ///< some corners have a UV, some don't
   bool has_normals = false;
   Index materials = 0;

@@ -960,10 +960,14 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
   }
 
   // Faces, in input order, pieces in walk order; attributes per surviving corner.
-  const bool uvs = mesh_.has_uvs(), normals = mesh_.has_normals();
+  const bool normals = mesh_.has_normals();
   const bool tag_o = !mesh_.face_object.empty(), tag_g = !mesh_.face_group.empty();
   const bool tag_m = !mesh_.face_material.empty(), tag_s = !mesh_.face_smoothing.empty();
-  om.uvs = mesh_.uvs;
+  om.uv_sets.resize(mesh_.uv_sets.size());
+  for (std::size_t k = 0; k < om.uv_sets.size(); ++k) {
+    om.uv_sets[k].name = mesh_.uv_sets[k].name;
+    om.uv_sets[k].values = mesh_.uv_sets[k].values;
+  }
   om.normals = mesh_.normals;
   om.object_names = mesh_.object_names;
   om.group_names = mesh_.group_names;
@@ -980,7 +984,7 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
       for (Index i = 0; i < len; ++i) {
         const Index c = piece_buf_[off + 1 + i];
         om.corner_vertex.push_back(new_id[root_of_corner(c)]);
-        if (uvs) om.corner_uv.push_back(mesh_.corner_uv[c]);
+        for (std::size_t k = 0; k < om.uv_sets.size(); ++k) om.uv_sets[k].corner.push_back(mesh_.uv_sets[k].corner[c]);
         if (normals) om.corner_normal.push_back(mesh_.corner_normal[c]);
       }
       om.face_offsets.push_back(static_cast<Index>(om.corner_vertex.size()));
