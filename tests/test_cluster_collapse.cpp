@@ -5,6 +5,7 @@
 
 #include "mesh/connectivity.h"
 #include "mesh/validation.h"
+#include "feature_test_util.h"
 #include "quadlod/generators.h"
 #include "quadlod/mesh.h"
 
@@ -156,9 +157,16 @@ TEST(ClusterCollapse, GridColumnChordRemovesOneColumn) {
     EXPECT_LE(p.x(), 3.0 / 6 + 1e-12);
     EXPECT_NEAR(p.x(), 2.5 / 6, 1e-9);  // symmetric: the middle
   }
-  // Surviving corners keep their own UV (grid: uv index == input vertex id).
-  for (Index c = 0; c < r.mesh.num_corners(); ++c)
-    EXPECT_EQ(r.vertex_map[r.mesh.uv_sets[0].corner[c]], r.mesh.corner_vertex[c]);
+  // The grid's UV is its position (unit square): unmoved corners keep their own UV index, the
+  // merged ones get the UV of their new position, projected into the one chart around them.
+  for (Index c = 0; c < r.mesh.num_corners(); ++c) {
+    const Index v = r.mesh.corner_vertex[c];
+    const Vec2 uv = r.mesh.uv_sets[0].values[r.mesh.uv_sets[0].corner[c]];
+    EXPECT_NEAR(uv.x(), r.mesh.positions[v].x(), 1e-12) << "corner " << c;
+    EXPECT_NEAR(uv.y(), r.mesh.positions[v].y(), 1e-12) << "corner " << c;
+  }
+  EXPECT_EQ(r.stats.uv_values_projected, m + 1);  // one wedge per merged vertex
+  EXPECT_EQ(r.stats.placements_on_feature_line, 2u);  // the two rungs on the boundary
 }
 
 TEST(ClusterCollapse, SingleEdgeBetweenTwoQuadsMakesTwoTriangles) {
@@ -496,6 +504,136 @@ TEST(ClusterCollapseInvariants, ClosedMeshesStayClosed) {
     EXPECT_EQ(s.boundary_edges, 0u);
     EXPECT_EQ(s.components, sin.components);
     EXPECT_GT(signed_volume(r.mesh), 0.0);
+  }
+}
+
+
+// --- features and attributes (issue 7) -------------------------------------------------------------
+
+
+// grid_with_seam_column(6, 4, 3, 0.5): the line x = 3/6 is a UV seam; left island UV = position,
+// right island UV = position + (0.5, 0). Collapsing the chord of column 2 merges x = 2/6 into the
+// seam line: the merged vertices must sit exactly on it, the left faces' corners there get the
+// left chart's UV of the seam point and the right faces keep the right chart's.
+TEST(ClusterCollapseFeatures, MergedVerticesStayOnTheSeamAndGetTheUvOfTheirSide) {
+  const Index n = 6, m = 4;
+  const PolyMesh in = feature_test::grid_with_seam_column(n, m, 3, 0.5);
+  const Connectivity conn = build_connectivity(in);
+  auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  for (Index j = 0; j <= m; ++j) {
+    const Vec3& p = r.mesh.positions[r.vertex_map[id(3, j)]];
+    EXPECT_NEAR(p.x(), 3.0 / 6, 1e-12) << "row " << j;  // on the seam, not in the middle
+    EXPECT_NEAR(p.y(), double(j) / m, 1e-12);
+  }
+  // Every output corner's UV is its position in its face's chart: left faces (centroid x < 3/6)
+  // unshifted, right faces shifted by 0.5.
+  for (Index f = 0; f < r.mesh.num_faces(); ++f) {
+    const double shift = face_centroid(r.mesh, f).x() < 3.0 / 6 ? 0.0 : 0.5;
+    for (Index c = r.mesh.face_begin(f); c < r.mesh.face_end(f); ++c) {
+      const Vec3& p = r.mesh.positions[r.mesh.corner_vertex[c]];
+      const Vec2 uv = r.mesh.uv_sets[0].values[r.mesh.uv_sets[0].corner[c]];
+      EXPECT_NEAR(uv.x(), p.x() + shift, 1e-12) << "face " << f;
+      EXPECT_NEAR(uv.y(), p.y(), 1e-12) << "face " << f;
+    }
+  }
+  // Two wedges per merged vertex (one per side of the seam).
+  EXPECT_EQ(r.stats.uv_values_projected, 2 * (m + 1));
+
+  // Without feature handling the vertices go to the middle and keep stale UVs.
+  ClusterCollapseParams plain;
+  plain.respect_features = false;
+  plain.project_attributes = false;
+  const ClusterCollapseResult p = collapse_clusters(in, conn, select(conn, chord), plain);
+  EXPECT_NEAR(p.mesh.positions[p.vertex_map[id(3, 2)]].x(), 2.5 / 6, 1e-9);
+  EXPECT_EQ(p.stats.uv_values_projected, 0u);
+}
+
+// A single column of material "B" between two columns of "A": collapsing its chord would make
+// the two A|B borders one A|A non-border — refused as `feature`, and nothing collapses.
+TEST(ClusterCollapseFeatures, ClusterJoiningTwoMaterialBordersIsRefused) {
+  const Index n = 5, m = 3;
+  PolyMesh in = make_grid(n, m);
+  feature_test::paint_columns(in, n, {"A", "B"}, {0, 0, 1, 0, 0});
+  const Connectivity conn = build_connectivity(in);
+  auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.refusals(CollapseRefusal::Feature), m + 1);
+  EXPECT_EQ(r.stats.collapsed_edges_final, 0u);
+  EXPECT_EQ(r.mesh.num_faces(), in.num_faces());
+  // The same chord next to the border (column 1, A|A on one side) is fine: the cluster holds one
+  // strict run (the border x = 2/5) and lands on it.
+  std::vector<std::pair<Index, Index>> beside;
+  for (Index j = 0; j <= m; ++j) beside.emplace_back(id(1, j), id(2, j));
+  const ClusterCollapseResult b = collapse_clusters(in, conn, select(conn, beside));
+  expect_valid_output(in, b);
+  EXPECT_EQ(b.stats.total_refusals(), 0u);
+  for (Index j = 0; j <= m; ++j) EXPECT_NEAR(b.mesh.positions[b.vertex_map[id(2, j)]].x(), 2.0 / 5, 1e-12);
+}
+
+// A vertex that is a feature corner (the grid's corner (0, 0)) stays where it is.
+TEST(ClusterCollapseFeatures, FeatureCornerDoesNotMove) {
+  const Index n = 4, m = 3;
+  const PolyMesh in = make_grid(n, m);
+  const Connectivity conn = build_connectivity(in);
+  auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(0, j), id(1, j));
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.mesh.positions[r.vertex_map[id(0, 0)]], in.positions[id(0, 0)]);
+  EXPECT_EQ(r.mesh.positions[r.vertex_map[id(0, m)]], in.positions[id(0, m)]);
+  EXPECT_EQ(r.stats.placements_at_feature_corner, 2u);
+  // The rows in between stay on the left boundary.
+  for (Index j = 1; j < m; ++j) EXPECT_NEAR(r.mesh.positions[r.vertex_map[id(0, j)]].x(), 0.0, 1e-12);
+}
+
+// A 3×3×3 cube with one normal per side (hard edges): after collapsing a ring chord, every
+// corner normal is its output face's normal — recomputed per side, the 90° edges stay hard.
+TEST(ClusterCollapseFeatures, NormalsAreRecomputedPerSideAndStayHard) {
+  PolyMesh in = make_cube(3, 1.0);
+  in.normals.clear();
+  in.corner_normal.assign(in.num_corners(), kInvalidIndex);
+  for (Index f = 0; f < in.num_faces(); ++f) {
+    const Vec3 n = face_normal(in, f);
+    Index id = kInvalidIndex;
+    for (Index k = 0; k < in.normals.size(); ++k)
+      if ((in.normals[k] - n).norm() < 1e-12) id = k;
+    if (id == kInvalidIndex) {
+      id = static_cast<Index>(in.normals.size());
+      in.normals.push_back(n);
+    }
+    for (Index c = in.face_begin(f); c < in.face_end(f); ++c) in.corner_normal[c] = id;
+  }
+  ASSERT_EQ(in.normals.size(), 6u);
+  const Connectivity conn = build_connectivity(in);
+  // The ring of edges parallel to x between the layers x = -1/6 and x = 1/6.
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  Index collapsed = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const auto [a, b] = conn.edge_vertices[e];
+    const Vec3 &pa = in.positions[a], &pb = in.positions[b];
+    if (std::abs(std::abs(pa.x() - pb.x()) - 1.0 / 3) < 1e-12 && std::abs(pa.x() + pb.x()) < 1e-12) {
+      kept[e] = 0;
+      ++collapsed;
+    }
+  }
+  ASSERT_EQ(collapsed, 12u);  // 3 + 3 + 3 + 3 around the ring
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  EXPECT_GT(r.stats.normals_recomputed, 0u);
+  for (Index f = 0; f < r.mesh.num_faces(); ++f) {
+    const Vec3 n = face_normal(r.mesh, f);
+    for (Index c = r.mesh.face_begin(f); c < r.mesh.face_end(f); ++c)
+      EXPECT_LT((r.mesh.normals[r.mesh.corner_normal[c]] - n).norm(), 1e-9) << "face " << f;
   }
 }
 

@@ -20,6 +20,7 @@ struct SimplifyCliOptions {
   std::string formulation = "fast";
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
+  bool no_features = false;
 };
 
 }  // namespace
@@ -67,6 +68,11 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--max-rounds", p.max_rounds,
                   "Selection/collapse rounds: later rounds pin refused collapses and re-aim at the target")
       ->check(CLI::Range(1, 64))->capture_default_str()->group("Guarantees");
+  sub->add_flag("--no-features", opt->no_features,
+                "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
+      ->group("Features");
+  sub->add_option("--hard-angle", p.hard_angle_deg, "Dihedral angle (degrees) from which an edge is a hard edge")
+      ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Features");
   sub->add_flag("--no-consistency", opt->no_consistency, "Ablation: drop Eq. 4")->group("Ablations");
   sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
@@ -98,6 +104,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.segmentation = !opt->no_segmentation;
             p.geometry = !opt->no_geometry;
             p.dual_repair = !opt->no_dual;
+            p.features = !opt->no_features;
             p.progress = !global.quiet;
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);

@@ -60,6 +60,15 @@ struct SimplifyOptions {
   bool geometry = true;      ///< Eqs. 6–8
   bool dual_repair = true;   ///< §3.3.1
 
+  // --- features (issue 7; docs/attributes.md) --------------------------------------------------
+  /// Keep UV seams, material borders, open boundaries and hard edges: the selection never
+  /// collapses an edge that would join two strict feature lines or two strict feature corners,
+  /// merged vertices stay on the feature line they touch, and UVs / normals of moved vertices are
+  /// recomputed per wedge. false: the paper's behaviour (features only weigh in the quadrics).
+  bool features = true;
+  /// Dihedral angle (degrees) from which a manifold edge is a hard edge (default ϵ_θ).
+  double hard_angle_deg = 60.0;
+
   // --- guarantees -------------------------------------------------------------------------------
   /// Bound on the distance of moved vertices from the input, relative to the bounding-box
   /// diagonal; <= 0 = no bound.

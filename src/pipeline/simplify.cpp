@@ -4,6 +4,7 @@
 
 #include "ilp/formulation.h"
 #include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
 #include "post/dual_repair.h"
@@ -23,6 +24,28 @@ double default_lambda_edge() { return SelectionParams{}.lambda_edge; }
 double default_lambda_tri() { return SelectionParams{}.lambda_tri; }
 
 namespace {
+
+// Edges the selection must keep so that no cluster can join two strict feature lines or move a
+// strict feature corner (issue 7, docs/attributes.md): a non-feature edge between two vertices on
+// strict lines (collapsing it would merge two seams, or pinch one), and any edge between two
+// feature corners of which one is strict. Chains through interior vertices (a ══ x ══ b with a, b on
+// different seams) are left to the collapse's `feature` refusal: they need two collapsed edges
+// that meet at a vertex, which chord collapses rarely produce.
+std::vector<std::uint8_t> feature_pins(const Connectivity& conn, const FeatureEdges& feat, Index& count) {
+  std::vector<std::uint8_t> pins(conn.num_edges, 0);
+  count = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const auto [a, b] = conn.edge_vertices[e];
+    if (a == b) continue;
+    const bool across = !feat.is_strict(e) && feat.on_strict(a) && feat.on_strict(b);
+    const bool corners = feat.vertex_corner[a] && feat.vertex_corner[b] && (feat.on_strict(a) || feat.on_strict(b));
+    if (across || corners) {
+      pins[e] = 1;
+      ++count;
+    }
+  }
+  return pins;
+}
 
 // One line per finished stage: "[3/5] select      1.84 s  (total 2.10 s)".
 class StageLog {
@@ -170,6 +193,9 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   dp.enable = options.dual_repair;
   ClusterCollapseParams cp;
   cp.max_hausdorff = options.max_hausdorff;
+  cp.respect_features = options.features;
+  cp.project_attributes = options.features;
+  cp.features.hard_angle_deg = options.hard_angle_deg;
 
   // Stages 2–4 — selection (§3.2), dual repair (§3.3.1), cluster collapse (§3.3.2) — run in
   // rounds (beyond the paper). The collapse refuses clusters that would break a guarantee, and
@@ -181,6 +207,25 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   const bool reducing = result.target < result.input_tri_equivalent;
   const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
   std::vector<std::uint8_t> pinned;
+  if (options.features) {
+    clock = Stopwatch();
+    const FeatureEdges feat = find_feature_edges(input, conn, cp.features);
+    Index pins = 0;
+    pinned = feature_pins(conn, feat, pins);
+    report["features"] = {
+        {"feature_edges", feat.feature_edges},
+        {"boundary_edges", feat.edges_with_bit[0]},
+        {"nonmanifold_edges", feat.edges_with_bit[1]},
+        {"uv_seam_edges", feat.edges_with_bit[2]},
+        {"normal_seam_edges", feat.edges_with_bit[3]},
+        {"material_border_edges", feat.edges_with_bit[4]},
+        {"hard_edges", feat.edges_with_bit[5]},
+        {"lines", feat.num_lines},
+        {"corners", feat.corners},
+        {"pinned_edges", pins},
+        {"seconds", clock.seconds()},
+    };
+  }
   std::int64_t selection_target = static_cast<std::int64_t>(result.target);
   std::int64_t previous_target = 0, previous_achieved = 0;
   std::optional<ClusterCollapseResult> best;
@@ -344,6 +389,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"geometry", options.geometry},
       {"dual_repair", options.dual_repair},
       {"max_hausdorff", options.max_hausdorff},
+      {"features", options.features},
+      {"hard_angle_deg", options.hard_angle_deg},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},

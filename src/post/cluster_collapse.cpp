@@ -87,6 +87,8 @@ class Collapser {
   }
   Index root_of_corner(Index c) const { return root_[conn_.corner_vertex[c]]; }
   void place(Index r);
+  bool place_on_feature(Index r, const Quadric& q);
+  bool features_valid(Index r);
   void split(Index r, CollapseRefusal why, bool dissolve);
 
   // --- faces -----------------------------------------------------------------------------------
@@ -106,6 +108,8 @@ class Collapser {
 
   // --- output ----------------------------------------------------------------------------------
   void assemble(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseResult& out);
+  void project_attributes(PolyMesh& om, std::vector<std::vector<Index>>& uv_override,
+                          std::vector<Index>& normal_override);
 
   const PolyMesh& mesh_;
   const Connectivity& conn_;
@@ -125,6 +129,8 @@ class Collapser {
   std::vector<double> edge_len_;
   std::vector<VertexTerms> terms_;
   std::vector<std::int8_t> input_nm_;  // input vertex non-manifold: 1 / 0, −1 not computed yet
+  bool features_on_ = false;
+  FeatureEdges feat_;
 
   // Clusters. Every vertex has a root (the smallest member id of its cluster); a root's members
   // are member_list_[seg_begin_[r], seg_end_[r]), sorted ascending.
@@ -202,6 +208,8 @@ void Collapser::precompute() {
     face_n_[f] = face_area_[f] > 0.0 ? Vec3(av / face_area_[f]) : Vec3::Zero();
   }
   input_nm_.assign(nv_, -1);
+  features_on_ = params_.respect_features;
+  if (features_on_) feat_ = find_feature_edges(mesh_, conn_, params_.features);
   build_vertex_terms();
 }
 
@@ -357,6 +365,10 @@ void Collapser::place(Index r) {
     q.b -= wr * psum;
     q.c += wr * p2sum;
   }
+  if (features_on_ && place_on_feature(r, q)) {
+    placed_round_[r] = round_;
+    return;
+  }
 
   const double cutoff = std::max(0.0, params_.eigen_cutoff);
   Eigen::LDLT<Eigen::Matrix3d> ldlt(q.A);
@@ -413,6 +425,117 @@ void Collapser::place(Index r) {
   }
   pos_[r] = x;
   placed_round_[r] = round_;
+}
+
+// Feature-constrained placement (issue 7). A cluster with exactly one feature corner sits on it.
+// A cluster touching a strict line — or, when it touches no strict line and no corner, exactly
+// one hard line — is placed at the minimiser of its quadric over the feature segments with an
+// endpoint in the cluster: the run of the line inside the cluster and the segment on either side.
+//
+//        ─────●═════●═════●──────      ● members on the line, ══ collapsed feature edges
+//          s0    s1    s2    s3        candidates: s0 … s3; the vertex lands on one of them,
+//                                      so the output line stays on the input polyline.
+//
+// Returns false when the cluster is not constrained (no feature, or two hard lines meeting: a
+// bevel between creases may collapse, placed by the plain quadric).
+bool Collapser::place_on_feature(Index r, const Quadric& q) {
+  Index corners = 0, corner = kInvalidIndex;
+  bool strict = false, any = false;
+  for (Index m : members(r)) {
+    if (!feat_.on_feature(m)) continue;
+    any = true;
+    strict = strict || feat_.on_strict(m);
+    if (feat_.vertex_corner[m]) {
+      ++corners;
+      corner = m;
+    }
+  }
+  if (!any) return false;
+  if (corners == 1) {
+    pos_[r] = mesh_.positions[corner];
+    ++stats_.placements_at_feature_corner;
+    return true;
+  }
+  // Candidate segments: feature edges (strict ones if the cluster is on a strict line) with an
+  // endpoint in the cluster; without a strict line they must all belong to one hard line.
+  edges_tmp_.clear();
+  Index line = kInvalidIndex;
+  for (Index m : members(r)) {
+    if (!feat_.on_feature(m)) continue;
+    for (Index c : conn_.corners_at_vertex(m))
+      for (Index ec : {c, conn_.corner_prev[c]}) {
+        const Index e = conn_.corner_edge[ec];
+        if (!feat_.is_feature(e) || (strict && !feat_.is_strict(e))) continue;
+        if (!strict) {
+          if (line == kInvalidIndex) line = feat_.edge_line[e];
+          else if (feat_.edge_line[e] != line) return false;
+        }
+        edges_tmp_.push_back(e);
+      }
+  }
+  if (edges_tmp_.empty() || (!strict && corners > 0)) return false;
+  std::sort(edges_tmp_.begin(), edges_tmp_.end());
+  edges_tmp_.erase(std::unique(edges_tmp_.begin(), edges_tmp_.end()), edges_tmp_.end());
+  // Q along p0 + t·d is quadratic in t: minimiser t = −dᵀ(A p0 + b) / dᵀAd, clamped to [0, 1].
+  double best_err = INFINITY;
+  Vec3 best = Vec3::Zero();
+  for (Index e : edges_tmp_) {
+    const auto [a, b] = conn_.edge_vertices[e];
+    const Vec3& p0 = mesh_.positions[a];
+    const Vec3 d = mesh_.positions[b] - p0;
+    const double dad = d.dot(q.A * d);
+    double t = 0.0;
+    if (dad > 0.0) t = std::clamp(-d.dot(q.A * p0 + q.b) / dad, 0.0, 1.0);
+    for (double cand : {t, 0.0, 1.0}) {
+      const Vec3 x = p0 + cand * d;
+      const double err = q(x);
+      if (err < best_err) {
+        best_err = err;
+        best = x;
+      }
+    }
+  }
+  if (!std::isfinite(best_err)) return false;
+  pos_[r] = best;
+  ++stats_.placements_on_feature_line;
+  return true;
+}
+
+// A cluster may hold at most one strict feature corner, and its members on strict lines must be
+// joined through collapsed strict feature edges: otherwise two seams (boundaries, material
+// borders) would meet in one vertex, or one line would be pinched shut.
+bool Collapser::features_valid(Index r) {
+  const auto ms = members(r);
+  Index strict_members = 0, strict_corners = 0;
+  for (Index m : ms)
+    if (feat_.on_strict(m)) {
+      ++strict_members;
+      strict_corners += feat_.vertex_corner[m];
+    }
+  if (strict_corners > 1) return false;
+  if (strict_members <= 1) return true;
+  const Index b = seg_begin_[r], e = seg_end_[r];
+  auto local = [&](Index v) {
+    return static_cast<Index>(std::lower_bound(member_list_.begin() + b, member_list_.begin() + e, v) -
+                              (member_list_.begin() + b));
+  };
+  UnionFind uf(e - b);
+  Index parts = strict_members;
+  for (Index m : ms) {
+    if (!feat_.on_strict(m)) continue;
+    for (Index c : conn_.corners_at_vertex(m))
+      for (Index ec : {c, conn_.corner_prev[c]}) {
+        const Index edge = conn_.corner_edge[ec];
+        if (!collapsed_[edge] || !feat_.is_strict(edge)) continue;
+        const Index o = conn_.other_vertex(edge, m);
+        if (o == m || root_[o] != r) continue;
+        const Index lm = local(m), lo = local(o);
+        if (uf.find(lm) == uf.find(lo)) continue;
+        uf.unite(lm, lo);
+        --parts;
+      }
+  }
+  return parts == 1;
 }
 
 // --- refusal: splitting a cluster --------------------------------------------------------------
@@ -700,6 +823,7 @@ bool Collapser::same_input_vertex_set(Index f, Index g) {
 // "New" compares with the input edges between the two clusters (all of them manifold / all
 // interior) and the members (none non-manifold).
 void Collapser::check_vertex(Index v) {
+  if (features_on_ && cluster_size(v) > 1 && !features_valid(v)) blame(v, CollapseRefusal::Feature);
   gather_fan(v);
   const Index nfan = static_cast<Index>(fan_.size());
   nbr_.clear();
@@ -959,7 +1083,8 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
     if (colors) om.vertex_colors[id] += mesh_.vertex_colors[v] / double(cluster_size(r));
   }
 
-  // Faces, in input order, pieces in walk order; attributes per surviving corner.
+  // Faces, in input order, pieces in walk order; attributes per surviving corner: its own input
+  // index, or the value projected / recomputed for its wedge when its vertex moved.
   const bool normals = mesh_.has_normals();
   const bool tag_o = !mesh_.face_object.empty(), tag_g = !mesh_.face_group.empty();
   const bool tag_m = !mesh_.face_material.empty(), tag_s = !mesh_.face_smoothing.empty();
@@ -969,6 +1094,17 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
     om.uv_sets[k].values = mesh_.uv_sets[k].values;
   }
   om.normals = mesh_.normals;
+  std::vector<std::vector<Index>> uv_override;
+  std::vector<Index> normal_override;
+  if (params_.project_attributes) project_attributes(om, uv_override, normal_override);
+  auto uv_of = [&](std::size_t k, Index c) {
+    const Index t = uv_override.empty() ? kInvalidIndex : uv_override[k][c];
+    return t != kInvalidIndex ? t : mesh_.uv_sets[k].corner[c];
+  };
+  auto normal_of = [&](Index c) {
+    const Index t = normal_override.empty() ? kInvalidIndex : normal_override[c];
+    return t != kInvalidIndex ? t : mesh_.corner_normal[c];
+  };
   om.object_names = mesh_.object_names;
   om.group_names = mesh_.group_names;
   om.material_names = mesh_.material_names;
@@ -984,8 +1120,8 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
       for (Index i = 0; i < len; ++i) {
         const Index c = piece_buf_[off + 1 + i];
         om.corner_vertex.push_back(new_id[root_of_corner(c)]);
-        for (std::size_t k = 0; k < om.uv_sets.size(); ++k) om.uv_sets[k].corner.push_back(mesh_.uv_sets[k].corner[c]);
-        if (normals) om.corner_normal.push_back(mesh_.corner_normal[c]);
+        for (std::size_t k = 0; k < om.uv_sets.size(); ++k) om.uv_sets[k].corner.push_back(uv_of(k, c));
+        if (normals) om.corner_normal.push_back(normal_of(c));
       }
       om.face_offsets.push_back(static_cast<Index>(om.corner_vertex.size()));
       if (tag_o) om.face_object.push_back(mesh_.face_object[f]);
@@ -1020,6 +1156,179 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
   if (stats_.largest_cluster == 0 && next > 0) stats_.largest_cluster = 1;
 }
 
+// --- attributes per wedge (issue 7) ---------------------------------------------------------------
+//
+// A moved vertex gets new attribute values per *sector*: the input faces around its cluster
+// (its star), joined across manifold edges whose two sides agree on the attribute. Each input
+// corner at a member belongs to its face's sector, so corners of one wedge share one new value and
+// a seam through the vertex keeps one value per side:
+//
+//        island A │ island B          sectors of the cluster {a, b} (a on the seam │):
+//          ┌──────a──────┐            A-faces → UV of the projection into island A's faces,
+//          │      ║      │            B-faces → UV of the projection into island B's faces;
+//          └──────b──────┘            the vertex stays on the seam (place_on_feature), so both
+//                                     projections land on the seam: no stretch across it.
+//
+// UVs: the closest point of the sector's input faces (fan triangles) to the new position, and the
+// barycentric mix of that triangle's corner UVs (Hoppe 1999's "project into the same chart").
+// Normals: the normalised sum of the area vectors of the output faces of the sector around the
+// vertex — recomputed where smooth, and hard edges stay hard because they separate sectors.
+void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>& uv_override,
+                                   std::vector<Index>& normal_override) {
+  const std::size_t sets = mesh_.uv_sets.size();
+  const bool normals = mesh_.has_normals();
+  if (sets == 0 && !normals) return;
+  uv_override.assign(sets, std::vector<Index>(mesh_.num_corners(), kInvalidIndex));
+  if (normals) normal_override.assign(mesh_.num_corners(), kInvalidIndex);
+
+  // The corner of face(o) at vertex v, for a corner o whose edge has v as an endpoint.
+  auto corner_at = [&](Index o, Index v) { return conn_.corner_vertex[o] == v ? o : conn_.corner_next[o]; };
+  auto same_uv = [&](const UvSet& set, Index c, Index o) {
+    const Index x = set.corner[c], y = set.corner[o];
+    if (x == kInvalidIndex || y == kInvalidIndex) return x == y;
+    return x == y || set.values[x] == set.values[y];
+  };
+  auto same_normal = [&](Index c, Index o) {
+    const Index x = mesh_.corner_normal[c], y = mesh_.corner_normal[o];
+    if (x == kInvalidIndex || y == kInvalidIndex) return x == y;
+    return x == y || mesh_.normals[x] == mesh_.normals[y];
+  };
+
+  struct Nearest {
+    double d2 = INFINITY;
+    Index c0 = kInvalidIndex, c1 = kInvalidIndex, c2 = kInvalidIndex;  // input corners
+    Vec3 w = Vec3::Zero();                                             // barycentric weights
+  };
+  std::vector<Index> star, star_slot(nf_, kInvalidIndex), sector(0);
+  std::vector<Nearest> nearest;
+  std::vector<Index> sector_value;
+  std::vector<Vec3> sector_normal;
+  for (Index r = 0; r < nv_; ++r) {
+    if (root_[r] != r || cluster_size(r) < 2) continue;
+    star.clear();
+    for (Index m : members(r))
+      for (Index c : conn_.corners_at_vertex(m)) {
+        const Index f = conn_.corner_face[c];
+        if (star_slot[f] != kInvalidIndex) continue;
+        star_slot[f] = static_cast<Index>(star.size());
+        star.push_back(f);
+      }
+    const Index ns = static_cast<Index>(star.size());
+    const Vec3& x = pos_[r];
+
+    // Closest point of each star face to the new position (independent of the attribute).
+    nearest.assign(ns, Nearest{});
+    for (Index i = 0; i < ns; ++i) {
+      const Index f = star[i], b = mesh_.face_begin(f), k = mesh_.face_size(f);
+      const Vec3& a = mesh_.positions[mesh_.corner_vertex[b]];
+      for (Index j = 1; j + 1 < k; ++j) {
+        const Vec3& p1 = mesh_.positions[mesh_.corner_vertex[b + j]];
+        const Vec3& p2 = mesh_.positions[mesh_.corner_vertex[b + j + 1]];
+        const TrianglePoint tp = closest_point_on_triangle(x, a, p1, p2);
+        if (!(tp.distance_sq < nearest[i].d2)) continue;
+        // Barycentric weights of the closest point (least squares; a sliver falls back to the
+        // nearest corner).
+        const Vec3 v0 = p1 - a, v1 = p2 - a, v2 = tp.point - a;
+        const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1);
+        const double d20 = v2.dot(v0), d21 = v2.dot(v1), den = d00 * d11 - d01 * d01;
+        Vec3 w;
+        if (den > 1e-12 * d00 * d11 && den > 0.0) {
+          const double wv = (d11 * d20 - d01 * d21) / den, ww = (d00 * d21 - d01 * d20) / den;
+          w = Vec3(1.0 - wv - ww, wv, ww);
+        } else {
+          const double da = v2.squaredNorm(), d1 = (tp.point - p1).squaredNorm(), d2 = (tp.point - p2).squaredNorm();
+          w = da <= d1 && da <= d2 ? Vec3(1, 0, 0) : d1 <= d2 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+        }
+        nearest[i] = {tp.distance_sq, b, b + j, b + j + 1, w};
+      }
+    }
+    // Does an output piece of star face i contain r? Only sectors with such a face need values.
+    auto face_uses_root = [&](Index f) {
+      Index off = piece_base(f);
+      for (Index p = 0; p < piece_count_[f]; ++p) {
+        const Index len = piece_buf_[off];
+        for (Index i = 0; i < len; ++i)
+          if (root_of_corner(piece_buf_[off + 1 + i]) == r) return true;
+        off += len + 1;
+      }
+      return false;
+    };
+
+    // Sectors for one attribute, then one new value per used sector.
+    auto label_sectors = [&](auto&& agree) {
+      UnionFind uf(ns);
+      for (Index i = 0; i < ns; ++i) {
+        const Index f = star[i];
+        for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
+          const Index o = conn_.across(c);
+          if (o == kInvalidIndex) continue;
+          const Index j = star_slot[conn_.corner_face[o]];
+          if (j == kInvalidIndex) continue;
+          const Index a = conn_.corner_vertex[c], b = conn_.tip_vertex(c);
+          if (agree(c, corner_at(o, a)) && agree(conn_.corner_next[c], corner_at(o, b))) uf.unite(i, j);
+        }
+      }
+      sector.resize(ns);
+      for (Index i = 0; i < ns; ++i) sector[i] = uf.find(i);
+    };
+    auto assign = [&](std::vector<Index>& override, auto&& value_for_sector) {
+      sector_value.assign(ns, kInvalidIndex);
+      for (Index i = 0; i < ns; ++i) {
+        const Index s = sector[i];
+        if (sector_value[s] == kInvalidIndex && face_uses_root(star[i])) sector_value[s] = value_for_sector(s);
+      }
+      for (Index m : members(r))
+        for (Index c : conn_.corners_at_vertex(m)) override[c] = sector_value[sector[star_slot[conn_.corner_face[c]]]];
+    };
+
+    for (std::size_t k = 0; k < sets; ++k) {
+      const UvSet& set = mesh_.uv_sets[k];
+      label_sectors([&](Index c, Index o) { return same_uv(set, c, o); });
+      assign(uv_override[k], [&](Index s) -> Index {
+        const Nearest* best = nullptr;
+        for (Index i = 0; i < ns; ++i) {
+          if (sector[i] != s) continue;
+          const Nearest& n = nearest[i];
+          if (n.c0 == kInvalidIndex || set.corner[n.c0] == kInvalidIndex || set.corner[n.c1] == kInvalidIndex ||
+              set.corner[n.c2] == kInvalidIndex)
+            continue;
+          if (!best || n.d2 < best->d2) best = &n;
+        }
+        if (!best) return kInvalidIndex;
+        const Vec2 uv = best->w[0] * set.values[set.corner[best->c0]] + best->w[1] * set.values[set.corner[best->c1]] +
+                        best->w[2] * set.values[set.corner[best->c2]];
+        om.uv_sets[k].values.push_back(uv);
+        ++stats_.uv_values_projected;
+        return static_cast<Index>(om.uv_sets[k].values.size() - 1);
+      });
+    }
+    if (normals) {
+      label_sectors(same_normal);
+      assign(normal_override, [&](Index s) -> Index {
+        Vec3 sum = Vec3::Zero();
+        for (Index i = 0; i < ns; ++i) {
+          if (sector[i] != s) continue;
+          Index off = piece_base(star[i]);
+          for (Index p = 0; p < piece_count_[star[i]]; ++p) {
+            const Index len = piece_buf_[off];
+            const Index* cs = piece_buf_.data() + off + 1;
+            off += len + 1;
+            bool has_r = false;
+            for (Index j = 0; j < len; ++j) has_r = has_r || root_of_corner(cs[j]) == r;
+            if (has_r) sum += area_vector(len, [&](Index j) -> const Vec3& { return pos_[root_of_corner(cs[j])]; });
+          }
+        }
+        const double n = sum.norm();
+        if (!(n > 0.0) || !std::isfinite(n)) return kInvalidIndex;
+        om.normals.push_back(sum / n);
+        ++stats_.normals_recomputed;
+        return static_cast<Index>(om.normals.size() - 1);
+      });
+    }
+    for (Index f : star) star_slot[f] = kInvalidIndex;
+  }
+}
+
 }  // namespace
 
 const char* to_string(CollapseRefusal reason) {
@@ -1032,6 +1341,7 @@ const char* to_string(CollapseRefusal reason) {
     case CollapseRefusal::Flip: return "flip";
     case CollapseRefusal::FoldedCorner: return "folded_corner";
     case CollapseRefusal::Hausdorff: return "hausdorff";
+    case CollapseRefusal::Feature: return "feature";
   }
   return "unknown";
 }
@@ -1103,6 +1413,10 @@ nlohmann::json to_json(const ClusterCollapseStats& s) {
       {"placements_volume_constrained", s.placements_volume_constrained},
       {"placements_pseudo_inverse", s.placements_pseudo_inverse},
       {"placements_fallback", s.placements_fallback},
+      {"placements_at_feature_corner", s.placements_at_feature_corner},
+      {"placements_on_feature_line", s.placements_on_feature_line},
+      {"uv_values_projected", s.uv_values_projected},
+      {"normals_recomputed", s.normals_recomputed},
       {"rounds", s.rounds},
       {"clusters_bisected", s.clusters_bisected},
       {"clusters_dissolved", s.clusters_dissolved},

@@ -19,12 +19,23 @@
 //      edges (or dissolved entirely after `max_bisect_rounds`), its refused edges become kept,
 //      and the check runs again on the faces that changed, until nothing is violated.
 //      Every refusal is counted by reason together with the triangle-equivalents it kept.
+//   4. Feature lines (issue 7, src/mesh/features.h; docs/attributes.md): a cluster that touches a
+//      feature line is placed *on* it — at its feature corner if it has one, else at the minimiser
+//      of its quadric along the feature segments around it — and a cluster that would join two
+//      strict feature lines (boundaries, UV seams, material borders) or two strict corners is
+//      refused. The selection already avoids such clusters (feature_pinned_edges); this is the
+//      guarantee behind it.
+//   5. Attributes per wedge: the UVs of a moved vertex are re-projected into the chart each of its
+//      corners came from (the input faces around the cluster joined across non-seam edges: one
+//      "sector" per wedge), normals are recomputed from the output faces of each sector (hard
+//      edges separate sectors, so they stay hard), vertex colours are averaged.
 //
 // Cost: linear in the mesh per round; rounds after the first only revisit the faces around
 // refused clusters.
 #pragma once
 
 #include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "quadlod/mesh.h"
 
 #include <nlohmann/json.hpp>
@@ -92,6 +103,15 @@ struct ClusterCollapseParams {
   /// around the cluster. <= 0: no bound.
   double max_hausdorff = 0.0;
 
+  // --- features and attributes (issue 7) -------------------------------------------------------
+  /// Keep merged vertices on feature lines and refuse clusters that join two strict lines or two
+  /// strict corners (point 4 above). false: the paper's plain quadric placement.
+  bool respect_features = true;
+  FeatureParams features;
+  /// Re-project UVs and recompute normals of moved vertices per wedge (point 5 above). false:
+  /// every surviving corner keeps its own input UV / normal index (UVs then stretch).
+  bool project_attributes = true;
+
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
   /// from then on a refused cluster is dissolved entirely. 0: always dissolve.
@@ -109,8 +129,9 @@ enum class CollapseRefusal : std::uint8_t {
   Flip,               ///< an output face turned more than flip_angle_deg from its input face
   FoldedCorner,       ///< a convex polygon corner became reflex
   Hausdorff,          ///< the placed vertex left the max_hausdorff band around the input
+  Feature,            ///< the cluster joins two strict feature lines or two strict corners
 };
-inline constexpr std::size_t kNumCollapseRefusals = 8;
+inline constexpr std::size_t kNumCollapseRefusals = 9;
 const char* to_string(CollapseRefusal reason);
 
 enum class ClusterCollapseStatus : std::uint8_t {
@@ -142,6 +163,11 @@ struct ClusterCollapseStats {
   Index placements_volume_constrained = 0;  ///< clusters placed under the volume constraint
   Index placements_pseudo_inverse = 0;      ///< ill-conditioned systems solved by eigen cutoff
   Index placements_fallback = 0;            ///< minimiser untrusted: best of centroid/members
+  Index placements_at_feature_corner = 0;   ///< clusters placed at their one feature corner
+  Index placements_on_feature_line = 0;     ///< clusters placed on the feature segments around them
+  // Attributes.
+  Index uv_values_projected = 0;    ///< new UV values (wedges of moved vertices, all sets)
+  Index normals_recomputed = 0;     ///< new normal values (wedges of moved vertices)
   // Refinement.
   Index rounds = 0;                ///< check rounds run (1 when nothing was refused)
   Index clusters_bisected = 0;
@@ -161,8 +187,9 @@ struct ClusterCollapseResult {
   ClusterCollapseStatus status = ClusterCollapseStatus::Ok;
   std::string error;  ///< why the input was rejected (status InvalidInput)
   /// The reduced mesh: positions of untouched vertices unchanged, uv/normal pools and name
-  /// tables copied whole, each surviving corner keeps its own uv/normal index, faces keep their
-  /// tags and the order of the input faces they come from. Vertex ids are compacted in the order
+  /// tables copied whole (new values for moved wedges appended), each surviving corner of an
+  /// unmoved vertex keeps its own uv/normal index, faces keep their tags and the order of the
+  /// input faces they come from. Vertex ids are compacted in the order
   /// of the smallest input vertex of each output vertex.
   PolyMesh mesh;
   /// Input vertex → output vertex, or kInvalidIndex for input vertices no output face uses.

@@ -1,0 +1,261 @@
+// Feature edges, feature corners, feature lines and UV islands (issue 7; contract in features.h).
+//
+// Everything is one pass over the edges (classification), one over the feature edges (vertex
+// valence, a vertex → feature-edge CSR, corners) and one walk per feature line, so the cost is
+// linear in the corners.
+//
+// Matching corners across an edge. Corner c0 of face f0 runs a → b. The other corner c1 of a
+// manifold edge runs b → a when the two faces are consistently oriented, a → b when one is
+// flipped. The attribute compared at endpoint a is the one at f0's corner sitting at a (c0) and at
+// f1's corner sitting at a:
+//
+//        b ───────── ...        consistent:  c1 at b, next(c1) at a  → pair (c0, next c1), (next c0, c1)
+//        │ ↑c0      │ f1        flipped:     c1 at a, next(c1) at b  → pair (c0, c1), (next c0, next c1)
+//        │ f0   c1↓ │
+//        a ───────── ...
+#include "mesh/features.h"
+
+#include "mesh/union_find.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace quadlod {
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+/// True when corners c0 and c1 of one edge run the same way (their faces are inconsistently
+/// oriented). A zero-length edge (both ends one vertex) counts as consistent.
+bool same_direction(const Connectivity& conn, Index c0, Index c1) {
+  return conn.corner_vertex[c1] == conn.corner_vertex[c0] && conn.corner_vertex[c0] != conn.tip_vertex(c0);
+}
+
+/// The corners of f1 facing c0's two endpoints (see the diagram above): {at tail of c0, at tip}.
+std::array<Index, 2> facing_corners(const Connectivity& conn, Index c0, Index c1) {
+  const Index n1 = conn.corner_next[c1];
+  return same_direction(conn, c0, c1) ? std::array<Index, 2>{c1, n1} : std::array<Index, 2>{n1, c1};
+}
+
+/// Two per-corner pool references differ "by value": exactly one is missing, or both exist and
+/// their values differ.
+template <class Pool>
+bool differ(const Pool& pool, Index a, Index b) {
+  const bool ha = a != kInvalidIndex, hb = b != kInvalidIndex;
+  if (ha != hb) return true;
+  if (!ha) return false;
+  return a != b && pool[a] != pool[b];
+}
+
+/// Does corner attribute (pool, corner index) differ across the manifold edge of c0 / c1?
+template <class Pool>
+bool seam_across(const Connectivity& conn, const Pool& pool, const std::vector<Index>& corner_ref,
+                 Index c0, Index c1) {
+  const std::array<Index, 2> f = facing_corners(conn, c0, c1);
+  return differ(pool, corner_ref[c0], corner_ref[f[0]]) ||
+         differ(pool, corner_ref[conn.corner_next[c0]], corner_ref[f[1]]);
+}
+
+/// Same material by name, so two table entries with one name do not make a border.
+bool same_material(const PolyMesh& m, Index f0, Index f1) {
+  const Index a = m.face_material[f0], b = m.face_material[f1];
+  if (a == b) return true;
+  if (a == kInvalidIndex || b == kInvalidIndex) return false;
+  return m.material_names[a] == m.material_names[b];
+}
+
+/// Angle in degrees between two non-zero vectors, atan2 form (accurate near 0° and 180°).
+double angle_deg(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)) * kDeg; }
+
+}  // namespace
+
+FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
+                                const FeatureParams& params) {
+  FeatureEdges fe;
+  fe.strict_bits = params.strict;
+  const Index ne = conn.num_edges, nv = conn.num_vertices;
+  fe.edge_bits.assign(ne, 0);
+  fe.edge_uv_seam_sets.assign(ne, 0);
+  fe.vertex_bits.assign(nv, 0);
+  fe.vertex_valence.assign(nv, 0);
+  fe.vertex_corner.assign(nv, 0);
+  fe.edge_line.assign(ne, kInvalidIndex);
+
+  const bool use_smoothing = params.smoothing_groups && !mesh.face_smoothing.empty();
+  const bool has_materials = !mesh.face_material.empty();
+  const std::size_t uv_sets = std::min<std::size_t>(mesh.uv_sets.size(), 32);
+  // Face normals on demand: only faces next to a manifold edge need one, each at most once.
+  std::vector<Vec3> normal(mesh.num_faces());
+  std::vector<char> normal_done(mesh.num_faces(), 0);
+  auto face_n = [&](Index f) -> const Vec3& {
+    if (!normal_done[f]) {
+      normal[f] = face_normal(mesh, f);
+      normal_done[f] = 1;
+    }
+    return normal[f];
+  };
+
+  // --- classify every edge -------------------------------------------------------------------
+  for (Index e = 0; e < ne; ++e) {
+    const Index count = conn.edge_face_count(e);
+    std::uint8_t bits = 0;
+    std::uint32_t seam_sets = 0;
+    if (count == 1) {
+      bits = kFeatureBoundary;
+    } else if (count > 2) {
+      bits = kFeatureNonManifold;
+    } else {
+      const auto cs = conn.corners_of_edge(e);
+      const Index c0 = cs[0], c1 = cs[1];
+      const Index f0 = conn.corner_face[c0], f1 = conn.corner_face[c1];
+      for (std::size_t k = 0; k < uv_sets; ++k)
+        if (seam_across(conn, mesh.uv_sets[k].values, mesh.uv_sets[k].corner, c0, c1))
+          seam_sets |= std::uint32_t{1} << k;
+      if (seam_sets) bits |= kFeatureUvSeam;
+      if (mesh.has_normals() && seam_across(conn, mesh.normals, mesh.corner_normal, c0, c1))
+        bits |= kFeatureNormalSeam;
+      if (has_materials && !same_material(mesh, f0, f1)) bits |= kFeatureMaterialBorder;
+      if (use_smoothing) {
+        const Index s0 = mesh.face_smoothing[f0], s1 = mesh.face_smoothing[f1];
+        if (s0 == 0 || s1 == 0 || s0 != s1) bits |= kFeatureHardEdge;
+      }
+      // Dihedral angle = angle between the face normals, with the second normal reversed when the
+      // faces are inconsistently oriented (else a flat but flipped pair would read as 180°).
+      // A zero-area face has no normal and never makes a hard edge.
+      const Vec3& n0 = face_n(f0);
+      const Vec3& n1 = face_n(f1);
+      if (!n0.isZero(0.0) && !n1.isZero(0.0)) {
+        if (angle_deg(n0, same_direction(conn, c0, c1) ? Vec3(-n1) : n1) >= params.hard_angle_deg) bits |= kFeatureHardEdge;
+      }
+    }
+    bits &= params.enabled;
+    if (!(bits & kFeatureUvSeam)) seam_sets = 0;
+    fe.edge_bits[e] = bits;
+    fe.edge_uv_seam_sets[e] = seam_sets;
+    if (!bits) continue;
+    ++fe.feature_edges;
+    for (int b = 0; b < 6; ++b)
+      if (bits & (1u << b)) ++fe.edges_with_bit[b];
+    for (Index v : conn.edge_vertices[e]) {
+      fe.vertex_bits[v] |= bits;
+      ++fe.vertex_valence[v];
+    }
+  }
+
+  // --- vertex → incident feature edges (CSR) ---------------------------------------------------
+  std::vector<Index> offsets(nv + 1, 0);
+  for (Index v = 0; v < nv; ++v) offsets[v + 1] = offsets[v] + fe.vertex_valence[v];
+  std::vector<Index> incident(offsets[nv]);
+  {
+    std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+    for (Index e = 0; e < ne; ++e)
+      if (fe.edge_bits[e])
+        for (Index v : conn.edge_vertices[e]) incident[fill[v]++] = e;
+  }
+
+  // --- corners --------------------------------------------------------------------------------
+  const auto& pos = mesh.positions;
+  for (Index v = 0; v < nv; ++v) {
+    const Index valence = fe.vertex_valence[v];
+    if (valence == 0) continue;
+    bool corner = valence != 2;
+    if (!corner) {
+      const Index e1 = incident[offsets[v]], e2 = incident[offsets[v] + 1];
+      if (fe.edge_bits[e1] != fe.edge_bits[e2] || fe.edge_uv_seam_sets[e1] != fe.edge_uv_seam_sets[e2]) {
+        corner = true;
+      } else {
+        // Turn angle: between the incoming direction (a → v) and the outgoing one (v → b), 0 when
+        // the line runs straight on. A zero-length edge has no direction and does not turn.
+        const Vec3 in = pos[v] - pos[conn.other_vertex(e1, v)];
+        const Vec3 out = pos[conn.other_vertex(e2, v)] - pos[v];
+        if (!in.isZero(0.0) && !out.isZero(0.0) && angle_deg(in, out) > params.corner_angle_deg) corner = true;
+      }
+    }
+    fe.vertex_corner[v] = corner ? 1 : 0;
+  }
+
+  // --- lines: walk from corners through valence-2 non-corners ----------------------------------
+  // Returns the feature edge at non-corner vertex w other than e (w has exactly two).
+  auto other_edge = [&](Index w, Index e) {
+    const Index a = incident[offsets[w]], b = incident[offsets[w] + 1];
+    return a == e ? b : a;
+  };
+  auto walk = [&](Index v, Index e, Index line) {
+    for (;;) {
+      fe.edge_line[e] = line;
+      const Index w = conn.other_vertex(e, v);
+      if (fe.vertex_corner[w]) return;
+      const Index next = other_edge(w, e);
+      if (fe.edge_line[next] != kInvalidIndex) return;  // closed loop, back at the start
+      v = w;
+      e = next;
+    }
+  };
+  for (Index v = 0; v < nv; ++v) {
+    if (!fe.vertex_corner[v]) continue;
+    for (Index k = offsets[v]; k < offsets[v + 1]; ++k)
+      if (fe.edge_line[incident[k]] == kInvalidIndex) walk(v, incident[k], fe.num_lines++);
+  }
+  // Closed loops made only of non-corner vertices: anchor each at its smallest vertex.
+  for (Index e = 0; e < ne; ++e) {
+    if (!fe.edge_bits[e] || fe.edge_line[e] != kInvalidIndex) continue;
+    Index smallest = conn.edge_vertices[e][0];
+    for (Index v = conn.edge_vertices[e][0], f = e;;) {  // first pass: find the smallest vertex
+      const Index w = conn.other_vertex(f, v);
+      smallest = std::min(smallest, w);
+      const Index next = other_edge(w, f);
+      if (next == e) break;
+      v = w;
+      f = next;
+    }
+    fe.vertex_corner[smallest] = 1;
+    walk(smallest, incident[offsets[smallest]], fe.num_lines++);
+  }
+  for (Index v = 0; v < nv; ++v) fe.corners += fe.vertex_corner[v];
+  return fe;
+}
+
+UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index uv_set) {
+  const UvSet& set = mesh.uv_sets[uv_set];
+  const Index nf = mesh.num_faces();
+  std::vector<char> has_uv(nf, 1);
+  for (Index f = 0; f < nf; ++f)
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c)
+      if (set.corner[c] == kInvalidIndex) has_uv[f] = 0;
+
+  UnionFind uf(nf);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    if (conn.edge_face_count(e) != 2) continue;
+    const auto cs = conn.corners_of_edge(e);
+    const Index f0 = conn.corner_face[cs[0]], f1 = conn.corner_face[cs[1]];
+    if (!has_uv[f0] || !has_uv[f1]) continue;
+    if (!seam_across(conn, set.values, set.corner, cs[0], cs[1])) uf.unite(f0, f1);
+  }
+
+  UvIslands r;
+  r.face_island.assign(nf, kInvalidIndex);
+  std::vector<Index> island_of_root(nf, kInvalidIndex);
+  for (Index f = 0; f < nf; ++f) {
+    if (!has_uv[f]) continue;
+    Index& id = island_of_root[uf.find(f)];
+    if (id == kInvalidIndex) {
+      id = r.num_islands++;
+      r.uv_min.push_back(Vec2::Constant(std::numeric_limits<double>::infinity()));
+      r.uv_max.push_back(Vec2::Constant(-std::numeric_limits<double>::infinity()));
+      r.area_3d.push_back(0.0);
+    }
+    r.face_island[f] = id;
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) {
+      const Vec2& uv = set.values[set.corner[c]];
+      r.uv_min[id] = r.uv_min[id].cwiseMin(uv);
+      r.uv_max[id] = r.uv_max[id].cwiseMax(uv);
+    }
+    r.area_3d[id] += face_area_vector(mesh, f).norm();
+  }
+  return r;
+}
+
+}  // namespace quadlod
