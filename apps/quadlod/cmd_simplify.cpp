@@ -68,6 +68,11 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--max-rounds", p.max_rounds,
                   "Selection/collapse rounds: later rounds pin refused collapses and re-aim at the target")
       ->check(CLI::Range(1, 64))->capture_default_str()->group("Guarantees");
+  sub->add_option("--pass-ratio", p.pass_ratio,
+                  "Split reductions below this ratio into passes of equal ratio, each at most this")
+      ->check(CLI::Range(0.05, 0.95))->capture_default_str()->group("Guarantees");
+  sub->add_option("--max-passes", p.max_passes, "Most passes (1 = one global selection, as in the paper)")
+      ->check(CLI::Range(1, 32))->capture_default_str()->group("Guarantees");
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
@@ -124,12 +129,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             const auto& rep = r.report;
             std::printf(
                 "simplify: target %llu, achieved %llu (%+.1f%%), %u quads, %u tris, %u n-gons; "
-                "analysis %.2f s, select %.2f s, dual %.2f s, collapse %.2f s (%zu rounds), total %.2f s\n",
+                "analysis %.2f s, select %.2f s, dual %.2f s, collapse %.2f s (%d pass%s, %zu rounds in the last), "
+                "total %.2f s\n",
                 static_cast<unsigned long long>(r.target), static_cast<unsigned long long>(r.achieved),
                 100.0 * rep["deviation"].get<double>(), r.quads, r.triangles, r.ngons,
                 rep["stage_seconds"]["analysis"].get<double>(), rep["stage_seconds"]["select"].get<double>(),
                 rep["stage_seconds"]["dual"].get<double>(), rep["stage_seconds"]["collapse"].get<double>(),
-                rep["rounds"].size(),
+                r.passes_used, r.passes_used == 1 ? "" : "es", rep["rounds"].size(),
                 read_seconds + rep["seconds"].get<double>() + write_seconds);
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;

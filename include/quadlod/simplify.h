@@ -54,6 +54,15 @@ struct SimplifyOptions {
   /// MIP budget of each round after the first, as a fraction of `time_limit_seconds`.
   double later_round_time_fraction = 0.25;
 
+  // --- passes (beyond the paper) ------------------------------------------------------------
+  /// A reduction below this ratio is split into passes of equal ratio, each at most this, each
+  /// one run of the whole pipeline on the previous pass's output (src/pipeline/simplify.cpp);
+  /// `time_limit_seconds` is shared among the planned passes. In (0, 1).
+  double pass_ratio = 0.5;
+  /// Most passes, the planned ones and extra ones that aim at N after a miss. 1 = one pass, the
+  /// paper's single global selection.
+  int max_passes = 6;
+
   // --- ablations (paper Table 2) ----------------------------------------------------------------
   bool consistency = true;   ///< Eq. 4
   bool segmentation = true;  ///< §3.2.2
@@ -86,7 +95,8 @@ struct SimplifyResult {
   std::uint64_t target = 0;
   std::uint64_t achieved = 0;  ///< tri-equivalents of `mesh`
   Index quads = 0, triangles = 0, ngons = 0;
-  int rounds_used = 0;  ///< the selection → collapse round whose output this is
+  int rounds_used = 0;  ///< in the last pass, the selection → collapse round whose output this is
+  int passes_used = 0;  ///< passes whose output was kept (1 unless the reduction was split)
   /// Everything measured on the way: per-stage seconds, analysis counts, model sizes, solver
   /// status / objective / bound / gap, repair and collapse statistics.
   nlohmann::json report;

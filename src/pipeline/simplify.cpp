@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 
@@ -131,19 +132,32 @@ nlohmann::json solve_json(const SelectionResult& s) {
 
 }  // namespace
 
-SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
-  SimplifyResult result;
-  Stopwatch total;
-  if (std::string problem = check_pipeline_input(input); !problem.empty()) {
-    result.error = problem;
-    return result;
-  }
-  if (!(options.ratio > 0.0 && options.ratio <= 1.0) && options.target_tri_equivalent == 0) {
-    result.error = "the target ratio must be in (0, 1]";
-    return result;
-  }
-  StageLog log(options.progress);
-  nlohmann::json& report = result.report;
+namespace {
+
+// What one pass (analysis → rounds of selection, repair, collapse) hands to the next.
+struct PassOutcome {
+  std::string error;
+  PolyMesh mesh;
+  nlohmann::json report;  // analysis, features, selection, dual_repair, collapse, rounds, stage_seconds
+  std::string note;       // the selection's "nothing to do", when that is what happened
+  std::uint64_t input_tri_equivalent = 0;
+  std::uint64_t achieved = 0;
+  int rounds_used = 0;
+  Index refusals = 0;
+  bool out_of_reach = false;
+  std::uint64_t predicted = 0;
+  std::int64_t selection_target = 0;
+  Index feature_pins = 0;
+  double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
+};
+
+// One pass of the paper's pipeline on `input`, aiming at `target` triangle-equivalents, with
+// `time_limit` seconds of MIP budget for its first round.
+PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time_limit,
+                        const SimplifyOptions& options, SelectionParams sp, const DualRepairParams& dp,
+                        const ClusterCollapseParams& cp, StageLog& log, const std::string& pass_tag) {
+  PassOutcome out;
+  nlohmann::json& report = out.report;
 
   // 1. Connectivity and analysis (§3.1, §3.2.2–§3.2.4).
   Stopwatch clock;
@@ -152,9 +166,9 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   ap.segmentation.enable = options.segmentation;
   ap.segmentation.epsilon_theta = options.epsilon_theta_deg * std::numbers::pi / 180.0;
   const AnalysisResult analysis = analyze(input, conn, ap);
-  const double analysis_seconds = clock.seconds();
+  out.seconds_analysis = clock.seconds();
   report["analysis"] = {
-      {"seconds", analysis_seconds},
+      {"seconds", out.seconds_analysis},
       {"polychords", analysis.polychords.chords.size()},
       {"polychords_closed", analysis.polychords.num_closed},
       {"polychords_self_crossing", analysis.polychords.num_self_crossing},
@@ -163,39 +177,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"quad_clusters", analysis.medial.clusters.size()},
       {"triangle_clusters", analysis.triangles.clusters.size()},
   };
-  log.done(1, "analysis", analysis_seconds, analysis_summary(input, analysis));
-
-  // 2. Target (§3.2, Eq. 2: triangle-equivalents).
-  result.input_tri_equivalent = tri_equivalent_count(input);
-  result.target = options.target_tri_equivalent > 0
-                      ? options.target_tri_equivalent
-                      : static_cast<std::uint64_t>(std::llround(options.ratio * double(result.input_tri_equivalent)));
-  SelectionParams sp;
-  sp.epsilon_n = options.epsilon_n;
-  if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
-  if (options.lambda_edge >= 0.0) sp.lambda_edge = options.lambda_edge;
-  if (options.lambda_tri >= 0.0) sp.lambda_tri = options.lambda_tri;
-  sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
-  sp.neighbourhood_groups = std::max<Index>(1, options.neighbourhood_groups);
-  if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
-  else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
-  else if (options.strategy != "auto") {
-    result.error = "unknown solver strategy '" + options.strategy + "' (auto, whole, neighbourhoods)";
-    return result;
-  }
-  sp.consistency = options.consistency;
-  sp.geometry = options.geometry;
-  sp.solver = options.solver;
-  sp.solve.threads = options.threads;
-  sp.solve.seed = options.seed;
-  sp.quiet = !options.progress;
-  DualRepairParams dp;
-  dp.enable = options.dual_repair;
-  ClusterCollapseParams cp;
-  cp.max_hausdorff = options.max_hausdorff;
-  cp.respect_features = options.features;
-  cp.project_attributes = options.features;
-  cp.features.hard_angle_deg = options.hard_angle_deg;
+  log.done(1, "analysis", out.seconds_analysis, analysis_summary(input, analysis) + pass_tag);
+  out.input_tri_equivalent = tri_equivalent_count(input);
 
   // Stages 2–4 — selection (§3.2), dual repair (§3.3.1), cluster collapse (§3.3.2) — run in
   // rounds (beyond the paper). The collapse refuses clusters that would break a guarantee, and
@@ -204,14 +187,13 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   // aims the selection below N by the drift the last round showed, and runs the three stages
   // again, until the result is within `round_tolerance` of N or `max_rounds` ran out. The round
   // closest to N is the result. docs/formulation.md ("Rounds") has the measurements.
-  const bool reducing = result.target < result.input_tri_equivalent;
+  const bool reducing = target < out.input_tri_equivalent;
   const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
   std::vector<std::uint8_t> pinned;
   if (options.features) {
     clock = Stopwatch();
     const FeatureEdges feat = find_feature_edges(input, conn, cp.features);
-    Index pins = 0;
-    pinned = feature_pins(conn, feat, pins);
+    pinned = feature_pins(conn, feat, out.feature_pins);
     report["features"] = {
         {"feature_edges", feat.feature_edges},
         {"boundary_edges", feat.edges_with_bit[0]},
@@ -222,27 +204,24 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
         {"hard_edges", feat.edges_with_bit[5]},
         {"lines", feat.num_lines},
         {"corners", feat.corners},
-        {"pinned_edges", pins},
+        {"pinned_edges", out.feature_pins},
         {"seconds", clock.seconds()},
     };
   }
-  std::int64_t selection_target = static_cast<std::int64_t>(result.target);
+  std::int64_t selection_target = static_cast<std::int64_t>(target);
   std::int64_t previous_target = 0, previous_achieved = 0;
   std::optional<ClusterCollapseResult> best;
   double best_distance = INFINITY;
-  Index best_refusals = 0;
-  double select_total = 0.0, dual_total = 0.0, collapse_total = 0.0;
   nlohmann::json rounds = nlohmann::json::array();
   for (int round = 1; round <= max_rounds; ++round) {
-    const std::string tag = round == 1 ? std::string() : " (round " + std::to_string(round) + ")";
-    sp.solve.time_limit_seconds =
-        round == 1 ? options.time_limit_seconds : options.time_limit_seconds * options.later_round_time_fraction;
+    const std::string tag = (round == 1 ? std::string() : " (round " + std::to_string(round) + ")") + pass_tag;
+    sp.solve.time_limit_seconds = round == 1 ? time_limit : time_limit * options.later_round_time_fraction;
     sp.keep_edges = pinned;
     clock = Stopwatch();
     const SelectionResult selection =
         select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
     const double select_seconds = clock.seconds();
-    select_total += select_seconds;
+    out.seconds_select += select_seconds;
     log.done(2, "select", select_seconds,
              "N' " + std::to_string(selection.predicted) + " of " + std::to_string(selection_target) +
                  (selection.solver_ran ? ", solver " + std::string(ilp::to_string(selection.solve.status)) : "") +
@@ -251,7 +230,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     clock = Stopwatch();
     const DualRepairResult repaired =
         repair_dual_graph(input, conn, analysis.polychords, selection.edge_kept, dp);
-    dual_total += clock.seconds();
+    out.seconds_dual += clock.seconds();
     log.done(3, "dual", clock.seconds(),
              std::to_string(repaired.stats.super_faces_found) + " super-faces, " +
                  std::to_string(repaired.stats.splits) + " splits" + tag);
@@ -259,15 +238,15 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     clock = Stopwatch();
     ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, cp);
     if (collapsed.status != ClusterCollapseStatus::Ok) {
-      result.error = collapsed.error;
-      return result;
+      out.error = collapsed.error;
+      return out;
     }
-    collapse_total += clock.seconds();
+    out.seconds_collapse += clock.seconds();
     const std::int64_t achieved = static_cast<std::int64_t>(collapsed.stats.tri_equivalent_out);
-    const std::int64_t drift = achieved - static_cast<std::int64_t>(result.target);
+    const std::int64_t drift = achieved - static_cast<std::int64_t>(target);
     log.done(4, "collapse", clock.seconds(),
              std::to_string(collapsed.stats.total_refusals()) + " clusters refused, " +
-                 std::to_string(achieved) + " of " + std::to_string(result.target) + tag);
+                 std::to_string(achieved) + " of " + std::to_string(target) + tag);
 
     // Edges the selection (after repair) collapsed and the collapse kept: refused.
     Index newly_pinned = 0;
@@ -313,13 +292,16 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       };
       report["collapse"] = to_json(collapsed.stats);
       report["collapse"]["seconds"] = collapsed.seconds;
-      result.note = selection.note;
-      result.rounds_used = round;
-      best_refusals = collapsed.stats.total_refusals();
+      out.note = selection.target >= selection.input_tri_equivalent ? selection.note : std::string();
+      out.out_of_reach = !selection.band_enforced;
+      out.predicted = selection.predicted;
+      out.selection_target = selection_target;
+      out.rounds_used = round;
+      out.refusals = collapsed.stats.total_refusals();
       best = std::move(collapsed);
     }
     rounds.push_back(std::move(round_json));
-    if (!reducing || distance <= options.round_tolerance * double(result.target)) break;
+    if (!reducing || distance <= options.round_tolerance * double(target)) break;
     // Re-aim: a secant step on achieved(selection target) through the last two rounds, its
     // slope kept in [0.5, 1] (refusals make the output move less than the selection, and pins
     // change the function between rounds), the target kept within [N/2, 3N/2].
@@ -330,19 +312,138 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     previous_achieved = achieved;
     const double aimed = double(selection_target) - double(drift) / slope;
     const std::int64_t next = static_cast<std::int64_t>(std::llround(
-        std::clamp(aimed, 0.5 * double(result.target), 1.5 * double(result.target))));
+        std::clamp(aimed, 0.5 * double(target), 1.5 * double(target))));
     if (next < 1 || (newly_pinned == 0 && next == selection_target)) break;
     selection_target = next;
   }
-  const int rounds_run = static_cast<int>(rounds.size());
   report["rounds"] = std::move(rounds);
-  report["stage_seconds"] = {{"analysis", analysis_seconds},
-                             {"select", select_total},
-                             {"dual", dual_total},
-                             {"collapse", collapse_total}};
+  report["stage_seconds"] = {{"analysis", out.seconds_analysis},
+                             {"select", out.seconds_select},
+                             {"dual", out.seconds_dual},
+                             {"collapse", out.seconds_collapse}};
+  out.mesh = std::move(best->mesh);
+  out.achieved = tri_equivalent_count(out.mesh);
+  return out;
+}
 
-  // 5. Summary.
-  result.mesh = std::move(best->mesh);
+}  // namespace
+
+SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+  SimplifyResult result;
+  Stopwatch total;
+  if (std::string problem = check_pipeline_input(input); !problem.empty()) {
+    result.error = problem;
+    return result;
+  }
+  if (!(options.ratio > 0.0 && options.ratio <= 1.0) && options.target_tri_equivalent == 0) {
+    result.error = "the target ratio must be in (0, 1]";
+    return result;
+  }
+  if (!(options.pass_ratio > 0.0 && options.pass_ratio < 1.0)) {
+    result.error = "the pass ratio must be in (0, 1)";
+    return result;
+  }
+  StageLog log(options.progress);
+  nlohmann::json& report = result.report;
+
+  // Target (§3.2, Eq. 2: triangle-equivalents).
+  result.input_tri_equivalent = tri_equivalent_count(input);
+  result.target = options.target_tri_equivalent > 0
+                      ? options.target_tri_equivalent
+                      : static_cast<std::uint64_t>(std::llround(options.ratio * double(result.input_tri_equivalent)));
+  SelectionParams sp;
+  sp.epsilon_n = options.epsilon_n;
+  if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
+  if (options.lambda_edge >= 0.0) sp.lambda_edge = options.lambda_edge;
+  if (options.lambda_tri >= 0.0) sp.lambda_tri = options.lambda_tri;
+  sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
+  sp.neighbourhood_groups = std::max<Index>(1, options.neighbourhood_groups);
+  if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
+  else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
+  else if (options.strategy != "auto") {
+    result.error = "unknown solver strategy '" + options.strategy + "' (auto, whole, neighbourhoods)";
+    return result;
+  }
+  sp.consistency = options.consistency;
+  sp.geometry = options.geometry;
+  sp.solver = options.solver;
+  sp.solve.threads = options.threads;
+  sp.solve.seed = options.seed;
+  sp.quiet = !options.progress;
+  DualRepairParams dp;
+  dp.enable = options.dual_repair;
+  ClusterCollapseParams cp;
+  cp.max_hausdorff = options.max_hausdorff;
+  cp.respect_features = options.features;
+  cp.project_attributes = options.features;
+  cp.features.hard_angle_deg = options.hard_angle_deg;
+  if (const char* en = std::getenv("QL_ENABLED")) cp.features.enabled = static_cast<std::uint8_t>(std::atoi(en));
+
+  // Passes (beyond the paper). One global selection can remove only so much: at 20 % of a
+  // low-poly character, the clusters of one selection grow so large that the collapse refuses
+  // most of them (a flip or fold somewhere in each) and the output stays far above N. So a large
+  // reduction is split into k passes of equal ratio, each at most `pass_ratio`
+  // (k = ⌈log(N/N₀) / log(pass_ratio)⌉), each one the whole pipeline on the previous pass's
+  // output with 1/k of the time budget. If the last planned pass still misses N by more than
+  // round_tolerance, further passes aim at N directly while they get closer, up to max_passes.
+  // docs/formulation.md ("Passes") has the measurements.
+  const double n0 = double(result.input_tri_equivalent), n = double(result.target);
+  const int max_passes = std::max(1, options.max_passes);
+  int planned = 1;
+  if (n < n0 && n > 0.0)
+    planned = std::clamp(static_cast<int>(std::ceil(std::log(n / n0) / std::log(options.pass_ratio) - 1e-9)), 1, max_passes);
+  const double pass_time = options.time_limit_seconds / planned;
+  PolyMesh current;
+  const PolyMesh* pass_input = &input;
+  PassOutcome last;
+  nlohmann::json passes = nlohmann::json::array();
+  double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
+  for (int pass = 1; pass <= max_passes; ++pass) {
+    const std::uint64_t pass_target =
+        pass < planned ? static_cast<std::uint64_t>(std::llround(n0 * std::pow(n / n0, double(pass) / planned)))
+                       : result.target;
+    const std::uint64_t pass_in = pass == 1 ? result.input_tri_equivalent : last.achieved;
+    if (pass > 1 && pass_target >= pass_in) break;
+    const std::string tag = planned == 1 && pass == 1 ? std::string() : " [pass " + std::to_string(pass) + "]";
+    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, dp, cp, log, tag);
+    if (!outcome.error.empty()) {
+      result.error = outcome.error;
+      return result;
+    }
+    seconds_analysis += outcome.seconds_analysis;
+    seconds_select += outcome.seconds_select;
+    seconds_dual += outcome.seconds_dual;
+    seconds_collapse += outcome.seconds_collapse;
+    passes.push_back({{"pass", pass},
+                      {"input_tri_equivalent", outcome.input_tri_equivalent},
+                      {"target", pass_target},
+                      {"achieved", outcome.achieved},
+                      {"time_limit_seconds", pass_time},
+                      {"report", outcome.report}});
+    const bool improved = pass <= planned || outcome.achieved < last.achieved;
+    if (!improved) break;  // an extra pass that does not get closer is dropped
+    last = std::move(outcome);
+    current = std::move(last.mesh);
+    pass_input = &current;
+    if (pass >= planned &&
+        std::abs(double(last.achieved) - n) <= options.round_tolerance * n)
+      break;
+    if (last.achieved <= result.target) break;
+  }
+  for (const char* key : {"analysis", "features", "selection", "dual_repair", "collapse", "rounds"})
+    if (last.report.contains(key)) report[key] = last.report[key];
+  report["passes"] = std::move(passes);
+  report["passes_planned"] = planned;
+  report["stage_seconds"] = {{"analysis", seconds_analysis},
+                             {"select", seconds_select},
+                             {"dual", seconds_dual},
+                             {"collapse", seconds_collapse}};
+
+  // Summary.
+  result.mesh = std::move(current);
+  result.note = last.note;
+  result.rounds_used = last.rounds_used;
+  result.passes_used = static_cast<int>(report["passes"].size());
   result.achieved = tri_equivalent_count(result.mesh);
   for (Index f = 0; f < result.mesh.num_faces(); ++f) {
     const Index k = result.mesh.face_size(f);
@@ -352,13 +453,27 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   }
   const double deviation = result.target ? (double(result.achieved) - double(result.target)) / double(result.target) : 0.0;
   if (result.note.empty() && std::abs(deviation) > options.epsilon_n && result.target < result.input_tri_equivalent) {
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "achieved %llu is %+.1f %% off the target %llu after %d rounds: the collapse refused "
-                  "%u clusters (report: collapse.refused) whose collapse would break a guarantee",
-                  static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
-                  static_cast<unsigned long long>(result.target), rounds_run,
-                  static_cast<unsigned>(best_refusals));
+    // Say which limit bit in the last pass: the hard constraints of the selection (feature pins,
+    // edges pinned after refusals, non-manifold edges), or the collapse refusing what the
+    // selection asked for.
+    char text[448];
+    if (last.out_of_reach)
+      std::snprintf(text, sizeof text,
+                    "achieved %llu is %+.1f %% off the target %llu after %d passes: in the last, the hard "
+                    "constraints (%u feature-pinned edges, edges of refused collapses) left no selection "
+                    "closer than %llu (aimed at %lld) and the collapse refused %u clusters (report: "
+                    "features, collapse.refused)",
+                    static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
+                    static_cast<unsigned long long>(result.target), result.passes_used,
+                    static_cast<unsigned>(last.feature_pins), static_cast<unsigned long long>(last.predicted),
+                    static_cast<long long>(last.selection_target), static_cast<unsigned>(last.refusals));
+    else
+      std::snprintf(text, sizeof text,
+                    "achieved %llu is %+.1f %% off the target %llu after %d passes: the collapse refused "
+                    "%u clusters (report: collapse.refused) whose collapse would break a guarantee",
+                    static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
+                    static_cast<unsigned long long>(result.target), result.passes_used,
+                    static_cast<unsigned>(last.refusals));
     result.note = text;
   }
   report["input_tri_equivalent"] = result.input_tri_equivalent;
@@ -394,9 +509,12 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},
+      {"pass_ratio", options.pass_ratio},
+      {"max_passes", options.max_passes},
   };
   log.done(5, "done", total.seconds(),
-           "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved));
+           "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +
+               (result.passes_used > 1 ? " in " + std::to_string(result.passes_used) + " passes" : ""));
   return result;
 }
 
