@@ -4,6 +4,9 @@
 
 #include "geometry/bvh.h"
 #include "geometry/sampling.h"
+#include "feature_test_util.h"
+#include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "quadlod/generators.h"
 #include "quadlod/io.h"
 
@@ -15,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <vector>
 
@@ -431,7 +435,7 @@ TEST(EvalMetrics, DeterministicForASeedAndIndependentOfThreads) {
     bumpy.positions[i] *= 1.0 + 0.02 * std::sin(7.0 * i);
   const PolyMesh torus = make_torus(30, 16);
   auto strip_times = [](nlohmann::json j) {
-    for (const char* k : {"seconds", "seconds_distance", "seconds_pccd", "threads"}) j.erase(k);
+    for (const char* k : {"seconds", "seconds_distance", "seconds_pccd", "seconds_features", "threads"}) j.erase(k);
     return j;
   };
   EvalParams p = small_params(3000, 2000);
@@ -495,6 +499,252 @@ TEST(EvalMetrics, JsonHasEveryMetric) {
   EXPECT_EQ(j["tri_equivalent_in"], 12 + 2 * 72 + 10);
 }
 
+// --- features, UVs, materials (docs/metrics.md §6c) ---------------------------------------------------
+
+using feature_test::grid_with_seam_column;
+using feature_test::paint_columns;
+
+/// A mesh with its UVs shifted by `delta` on the faces of columns >= split of a make_grid(n, ·).
+PolyMesh with_uv_offset(PolyMesh g, Index n, Index split, const Vec2& delta) {
+  UvSet& uv = g.uv_sets[0];
+  std::vector<char> moved(uv.values.size(), 0);
+  for (Index f = 0; f < g.num_faces(); ++f)
+    if (f % n >= split)
+      for (Index c = g.face_begin(f); c < g.face_end(f); ++c) moved[uv.corner[c]] = 1;
+  for (std::size_t k = 0; k < uv.values.size(); ++k)
+    if (moved[k]) uv.values[k] += delta;
+  return g;
+}
+
+TEST(EvalFeatures, MeshAgainstItselfTearsNothing) {
+  PolyMesh g = grid_with_seam_column(6, 4, 3, 0.5);
+  paint_columns(g, 6, {"red", "green", "blue"}, {0, 0, 1, 1, 2, 2});
+  PolyMesh cube = make_cube(2);
+  for (const PolyMesh* m : {&g, &cube}) {
+    const EvalResult r = evaluate(*m, *m, small_params());
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_EQ(r.seams_torn, 0u);
+    EXPECT_EQ(r.uv_islands_in, r.uv_islands_out);
+    EXPECT_EQ(r.uv_samples, r.samples_out);
+    EXPECT_LE(r.uv_error_max, 1e-14);
+    EXPECT_LE(r.feature_deviation_max, 1e-15);
+    EXPECT_EQ(r.feature_edges_in, r.feature_edges_out);
+  }
+  const EvalResult r = evaluate(g, g, small_params());
+  EXPECT_EQ(r.uv_islands_in, 2u);
+  EXPECT_EQ(r.seam_edges_in, 4u);
+  EXPECT_EQ(r.boundary_edges_in, 20u);
+  EXPECT_EQ(r.material_border_edges_out, 8u);
+  EXPECT_EQ(r.material_border_error, 0.0);
+  EXPECT_EQ(r.material_mismatch_fraction, 0.0);
+  // make_cube shares one UV lattice between all sides: corners of different sides that meet carry
+  // different values except where the lattice happens to agree, so islands are whole sides.
+  EXPECT_EQ(evaluate(cube, cube, small_params()).uv_islands_in, 6u);
+}
+
+TEST(EvalFeatures, SlitInAGridTearsItsEdges) {
+  // Grid 4×4 over [0,1]²; the vertex at (½, ½) is duplicated for the two faces above the row
+  // y = ½ between x = ¼ and ¾: the two edges of that row open into a slit of 4 boundary edges.
+  const Index n = 4;
+  const PolyMesh g = make_grid(n, n);
+  PolyMesh slit = g;
+  const Index centre = 2 * (n + 1) + 2;
+  const Index copy = slit.add_vertex(slit.positions[centre]);
+  for (Index f : {Index{2 * n + 1}, Index{2 * n + 2}})  // faces (1, 2) and (2, 2)
+    for (Index c = slit.face_begin(f); c < slit.face_end(f); ++c)
+      if (slit.corner_vertex[c] == centre) slit.corner_vertex[c] = copy;
+  const EvalResult r = evaluate(g, slit, small_params());
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.boundary_edges_out, 16u + 4u);
+  EXPECT_EQ(r.seams_torn, 4u);
+  EXPECT_EQ(r.uv_islands_out, 1u);
+  EXPECT_LE(r.uv_error_max, 1e-14);
+  // The slit's sample points nearest the centre, x = ½ ± 1/16, are 7/16 from the boundary.
+  EXPECT_NEAR(r.feature_deviation_max, 7.0 / 16.0, 1e-15);
+  EXPECT_EQ(evaluate(slit, g, small_params()).seams_torn, 0u);  // closing a slit tears nothing
+}
+
+TEST(EvalFeatures, NewSeamThroughAnIslandIsTornAndMergedSeamIsNot) {
+  const Index n = 4;
+  const PolyMesh plain = make_grid(n, n);
+  const PolyMesh seamed = grid_with_seam_column(n, n, 2, 0.5);
+  const EvalResult torn = evaluate(plain, seamed, small_params());
+  EXPECT_EQ(torn.seams_torn, n);
+  EXPECT_EQ(torn.seam_edges_out, n);
+  EXPECT_EQ(torn.uv_islands_in, 1u);
+  EXPECT_EQ(torn.uv_islands_out, 2u);
+  // Both output islands map to the one input island; the right half's UVs are off by ½ in u,
+  // over the input island's diagonal √2.
+  EXPECT_NEAR(torn.uv_error_max, 0.5 / std::sqrt(2.0), 1e-12);
+  const EvalResult merged = evaluate(seamed, plain, small_params());
+  EXPECT_EQ(merged.seams_torn, 0u);
+  EXPECT_EQ(merged.uv_islands_out, 1u);
+  // A seam moved by one column (from x = ½ to x = ¾) is torn; a seam moved by less than
+  // feature_tolerance of its edge length is not.
+  EXPECT_EQ(evaluate(seamed, grid_with_seam_column(n, n, 3, 0.5), small_params()).seams_torn, n);
+  PolyMesh nudged = seamed;
+  for (Index j = 0; j <= n; ++j) nudged.positions[j * (n + 1) + 2].x() += 0.1 * 0.25;
+  EXPECT_EQ(evaluate(seamed, nudged, small_params()).seams_torn, 0u);
+  nudged = seamed;
+  for (Index j = 0; j <= n; ++j) nudged.positions[j * (n + 1) + 2].x() += 0.3 * 0.25;
+  EXPECT_EQ(evaluate(seamed, nudged, small_params()).seams_torn, n);
+}
+
+TEST(EvalFeatures, UvOffsetIsTheOffsetOverTheIslandDiagonal) {
+  const Index n = 4;
+  const PolyMesh in = grid_with_seam_column(n, n, 2, 0.5);  // islands of UV size ½ × 1
+  const Vec2 delta(0.03, 0.04);
+  const double expected = 0.05 / std::sqrt(0.25 + 1.0);
+  // Both islands moved: every sample is off by exactly |delta| / diagonal.
+  const EvalResult both = evaluate(in, with_uv_offset(in, n, 0, delta), small_params());
+  EXPECT_NEAR(both.uv_error_mean, expected, 1e-12);
+  EXPECT_NEAR(both.uv_error_max, expected, 1e-12);
+  // One island moved: half the area (binomial share of the samples) is off by that much.
+  const EvalParams p = small_params();
+  const EvalResult one = evaluate(in, with_uv_offset(in, n, 2, delta), p);
+  EXPECT_NEAR(one.uv_error_max, expected, 1e-12);
+  EXPECT_NEAR(one.uv_error_mean, 0.5 * expected, 5 * 0.5 / std::sqrt(double(p.samples)) * expected);
+  EXPECT_EQ(one.seams_torn, 0u);
+  // No UVs on either side: not measured.
+  PolyMesh bare = in;
+  bare.uv_sets.clear();
+  const EvalResult none = evaluate(in, bare, small_params());
+  EXPECT_TRUE(std::isnan(none.uv_error_mean));
+  EXPECT_TRUE(to_json(none)["uv_error_max"].is_null());
+  EXPECT_EQ(none.uv_islands_out, 0u);
+  EXPECT_EQ(none.uv_samples, 0u);
+}
+
+TEST(EvalFeatures, MaterialsAreComparedByName) {
+  const Index n = 4;
+  PolyMesh in = make_grid(n, n);
+  paint_columns(in, n, {"red", "blue"}, {0, 0, 1, 1});
+  // Another name table, the same painting: nothing differs.
+  PolyMesh renamed = make_grid(n, n);
+  paint_columns(renamed, n, {"blue", "red"}, {1, 1, 0, 0});
+  EvalResult r = evaluate(in, renamed, small_params());
+  EXPECT_EQ(r.material_mismatch_fraction, 0.0);
+  EXPECT_EQ(r.material_border_error, 0.0);
+  // Swapped: every sample mismatches, the border is where it was (same unordered pair).
+  PolyMesh swapped = make_grid(n, n);
+  paint_columns(swapped, n, {"red", "blue"}, {1, 1, 0, 0});
+  r = evaluate(in, swapped, small_params());
+  EXPECT_EQ(r.material_mismatch_fraction, 1.0);
+  EXPECT_EQ(r.material_border_error, 0.0);
+  EXPECT_EQ(r.material_border_edges_out, n);
+  // Column 1 repainted blue: the border moves from x = ½ to x = ¼, a quarter of the area changes.
+  PolyMesh moved = make_grid(n, n);
+  paint_columns(moved, n, {"red", "blue"}, {0, 1, 1, 1});
+  const EvalParams p = small_params();
+  r = evaluate(in, moved, p);
+  EXPECT_NEAR(r.material_border_error, 0.25, 1e-15);
+  EXPECT_NEAR(r.material_border_error_mean, 0.25, 1e-15);
+  EXPECT_NEAR(r.material_mismatch_fraction, 0.25, 5 * std::sqrt(0.25 * 0.75 / double(p.samples)));
+  // Feature deviation of the moved border (length 1) against boundary ∪ input border: ¼ except
+  // for the end edges' quarter points, which are 1/16, 1/8, 3/16 from y = 0 (or y = 1).
+  // Length-weighted mean over the boundary (length 4, on the input) and the border:
+  // ¼ · (2 · ⅛ + 2 · ¼) / 5 = 0.0375.
+  EXPECT_NEAR(r.feature_deviation_max, 0.25, 1e-15);
+  EXPECT_NEAR(r.feature_deviation_mean, 0.0375, 1e-15);
+  // A border between materials that never met in the input: the missing-feature penalty, 1.
+  PolyMesh green = make_grid(n, n);
+  paint_columns(green, n, {"red", "blue", "green"}, {0, 0, 1, 2});
+  r = evaluate(in, green, small_params());
+  EXPECT_EQ(r.material_border_error, 1.0);
+  // Without materials on either side: not measured.
+  r = evaluate(make_grid(n, n), make_grid(n, n), small_params());
+  EXPECT_TRUE(std::isnan(r.material_mismatch_fraction));
+  EXPECT_TRUE(std::isnan(r.material_border_error));
+}
+
+/// UV at a point of a triangle by solving the 2×2 normal equations (independent of uv_at).
+Vec2 oracle_uv(const std::array<Vec3, 3>& t, const std::array<Vec2, 3>& uv, const Vec3& p) {
+  Eigen::Matrix<double, 3, 2> a;
+  a.col(0) = t[1] - t[0];
+  a.col(1) = t[2] - t[0];
+  const Eigen::Vector2d w = a.colPivHouseholderQr().solve(p - t[0]);
+  return uv[0] + w[0] * (uv[1] - uv[0]) + w[1] * (uv[2] - uv[0]);
+}
+
+TEST(EvalFeatures, UvErrorMatchesBruteForceOracle) {
+  // Input: a bent 6×6 grid with a seam at x = ½. Output: a bent 4×4 grid (other bend), its own
+  // UVs (u = x², v = y) and a seam at x = ½, so output samples near the seam have their
+  // unrestricted closest input point on the other island.
+  const Index n_in = 6, n_out = 4;
+  PolyMesh input = grid_with_seam_column(n_in, n_in, 3, 0.5);
+  for (Vec3& p : input.positions) p.z() = 0.2 * std::sin(3.0 * p.x()) * std::cos(2.0 * p.y());
+  PolyMesh output = grid_with_seam_column(n_out, n_out, 2, 0.25);
+  for (Vec3& p : output.positions) p.z() = 0.25 * std::sin(2.9 * p.x()) * std::cos(2.2 * p.y()) + 0.01;
+  for (Vec2& uv : output.uv_sets[0].values) uv.x() = uv.x() * uv.x();
+  const EvalParams params = small_params(1500, 500);
+  const EvalResult r = evaluate(input, output, params);
+  ASSERT_TRUE(r.ok()) << r.error;
+
+  // Oracle: the same scaling and samples, brute-force nearest triangles.
+  const BoundingBox box = bounding_box(input);
+  const double s = 1.0 / box.longest_side();
+  const Vec3 c = 0.5 * (box.min + box.max);
+  auto scaled = [&](PolyMesh m) {
+    for (Vec3& p : m.positions) p = (p - c) * s;
+    return m;
+  };
+  const PolyMesh in = scaled(input), out = scaled(output);
+  const TriangleSoup soup_in = fan_triangulate(in), soup_out = fan_triangulate(out);
+  const SurfaceSamples samples = sample_triangles(soup_out, params.samples, params.seed, 1);
+  const UvIslands is_in = find_uv_islands(in, build_connectivity(in), 0);
+  const UvIslands is_out = find_uv_islands(out, build_connectivity(out), 0);
+  auto tri_uv = [](const PolyMesh& m, const TriangleSoup& soup, std::size_t t) {
+    const Index f = soup.face[t];
+    Index k = 0;  // position of t in its face's fan
+    while (t > k && soup.face[t - k - 1] == f) ++k;
+    const UvSet& set = m.uv_sets[0];
+    const Index b = m.face_begin(f);
+    return std::array<Vec2, 3>{set.values[set.corner[b]], set.values[set.corner[b + k + 1]],
+                               set.values[set.corner[b + k + 2]]};
+  };
+  auto brute = [&](const Vec3& p, auto&& accept) {
+    std::size_t best = 0;
+    TrianglePoint bp;
+    bp.distance_sq = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
+      if (!accept(t)) continue;
+      const auto& tr = soup_in.triangles[t];
+      const TrianglePoint q = closest_point_on_triangle(p, tr[0], tr[1], tr[2]);
+      if (q.distance_sq < bp.distance_sq) {
+        bp = q;
+        best = t;
+      }
+    }
+    return std::pair{best, bp.point};
+  };
+  std::map<std::pair<Index, Index>, int> votes;
+  std::vector<std::size_t> nearest(samples.points.size());
+  for (std::size_t k = 0; k < samples.points.size(); ++k) {
+    nearest[k] = brute(samples.points[k], [](std::size_t) { return true; }).first;
+    ++votes[{is_out.face_island[soup_out.face[samples.triangle[k]]], is_in.face_island[soup_in.face[nearest[k]]]}];
+  }
+  std::map<Index, std::pair<int, Index>> target;  // output island → (votes, input island)
+  for (const auto& [key, count] : votes)
+    if (count > target[key.first].first) target[key.first] = {count, key.second};
+  EXPECT_EQ(target[0].second, 0u);
+  EXPECT_EQ(target[1].second, 1u);
+  double sum = 0, mx = 0;
+  for (std::size_t k = 0; k < samples.points.size(); ++k) {
+    const Index ii = target[is_out.face_island[soup_out.face[samples.triangle[k]]]].second;
+    const auto [t, q] = brute(samples.points[k], [&](std::size_t t) { return is_in.face_island[soup_in.face[t]] == ii; });
+    const Vec2 uv_out = oracle_uv(soup_out.triangles[samples.triangle[k]], tri_uv(out, soup_out, samples.triangle[k]),
+                                  samples.points[k]);
+    const Vec2 uv_in = oracle_uv(soup_in.triangles[t], tri_uv(in, soup_in, t), q);
+    const double e = (uv_out - uv_in).norm() / (is_in.uv_max[ii] - is_in.uv_min[ii]).norm();
+    sum += e;
+    mx = std::max(mx, e);
+  }
+  EXPECT_EQ(r.uv_samples, samples.points.size());
+  EXPECT_NEAR(r.uv_error_mean, sum / double(samples.points.size()), 1e-12);
+  EXPECT_NEAR(r.uv_error_max, mx, 1e-12);
+  EXPECT_GT(mx, 0.05);  // the test measures something
+}
+
 // --- corpus ---------------------------------------------------------------------------------------------
 
 TEST(EvalCorpus, SuzanneAgainstItselfAndItsTriangulation) {
@@ -512,6 +762,13 @@ TEST(EvalCorpus, SuzanneAgainstItselfAndItsTriangulation) {
   EXPECT_EQ(self.counts_in.quads, 468u);
   EXPECT_EQ(self.counts_in.tris, 32u);
   EXPECT_EQ(self.flow_deviation_deg, 0.0);
+  EXPECT_EQ(self.uv_islands_in, 5u);
+  EXPECT_EQ(self.uv_islands_out, 5u);
+  EXPECT_EQ(self.seams_torn, 0u);
+  EXPECT_EQ(self.seam_edges_in, 50u);
+  EXPECT_EQ(self.boundary_edges_in, 42u);
+  EXPECT_LE(self.uv_error_max, 1e-12);
+  EXPECT_LE(self.feature_deviation_max, 1e-12);
   const EvalResult tri = evaluate(rr.mesh, fan_triangulated(rr.mesh), small_params());
   EXPECT_EQ(tri.qpr, 0.0);
   EXPECT_LE(tri.hausdorff, 1e-12);

@@ -1,5 +1,6 @@
 // `quadlod eval INPUT OUTPUT [--json] [--samples N] [--seed S]`: the §4.1 metrics of OUTPUT
-// against INPUT, plus the output's validity counts (docs/metrics.md).
+// against INPUT, the feature / UV / material metrics (§6c), plus the output's validity counts
+// (docs/metrics.md).
 #include "commands.h"
 
 #include "mesh/connectivity.h"
@@ -21,6 +22,7 @@ struct EvalOptions {
   bool json = false;
   std::uint64_t samples = EvalParams{}.samples;
   std::uint64_t seed = EvalParams{}.seed;
+  double feature_tolerance = EvalParams{}.feature_tolerance;
   unsigned threads = 0;
 };
 
@@ -28,7 +30,7 @@ struct EvalOptions {
 
 Command add_eval(CLI::App& app, const GlobalOptions& global) {
   auto opt = std::make_shared<EvalOptions>();
-  CLI::App* sub = app.add_subcommand("eval", "Metrics of OUTPUT against INPUT (QPR, PCCD, Chamfer, Hausdorff, flow)");
+  CLI::App* sub = app.add_subcommand("eval", "Metrics of OUTPUT against INPUT (QPR, PCCD, Chamfer, Hausdorff, flow, seams, UVs, materials)");
   sub->add_option("INPUT", opt->input, "The original mesh")->required();
   sub->add_option("OUTPUT", opt->output, "The reduced mesh")->required();
   sub->add_flag("--json", opt->json, "Print one JSON object instead of text");
@@ -36,6 +38,10 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(std::uint64_t{1000}, std::uint64_t{100000000}))
       ->capture_default_str();
   sub->add_option("--seed", opt->seed, "Sampling seed (results are deterministic per seed)")->capture_default_str();
+  sub->add_option("--feature-tolerance", opt->feature_tolerance,
+                  "Torn seams: allowed distance from the input seam, as a fraction of the output edge's length")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   sub->add_option("--threads", opt->threads, "Worker threads (0 = all cores); results do not depend on it")
       ->capture_default_str();
   return {sub, [opt, &global]() -> int {
@@ -49,6 +55,7 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
             params.samples = opt->samples;
             params.seed = opt->seed;
             params.threads = opt->threads;
+            params.feature_tolerance = opt->feature_tolerance;
             const EvalResult r = evaluate(in.mesh, out.mesh, params);
             if (!r.ok()) return fail(opt->output + ": " + r.error);
             const MeshStats validity = compute_stats(out.mesh, build_connectivity(out.mesh));
@@ -88,6 +95,18 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
             std::printf("  hausdorff           %.4e\n", num(r.hausdorff));
             std::printf("  flow deviation      %.2f deg mean, %.2f deg p90, coverage %.3f\n",
                         num(r.flow_deviation_deg), num(r.flow_deviation_p90_deg), num(r.flow_coverage));
+            std::printf("  uv                  islands %llu -> %llu, %llu seams torn, error %.4e mean, %.4e max\n",
+                        (unsigned long long)r.uv_islands_in, (unsigned long long)r.uv_islands_out,
+                        (unsigned long long)r.seams_torn, num(r.uv_error_mean), num(r.uv_error_max));
+            if (std::isnan(r.material_mismatch_fraction))
+              std::printf("  materials           none in either mesh\n");
+            else
+              std::printf("  materials           border error %.4e max, %.4e mean; mismatch %.4f\n",
+                          num(r.material_border_error), num(r.material_border_error_mean),
+                          num(r.material_mismatch_fraction));
+            std::printf("  feature lines       deviation %.4e max, %.4e mean (%llu -> %llu edges)\n",
+                        num(r.feature_deviation_max), num(r.feature_deviation_mean),
+                        (unsigned long long)r.feature_edges_in, (unsigned long long)r.feature_edges_out);
             std::printf("  output validity     %u non-manifold edges (input %u), %u degenerate, %u duplicate, "
                         "%llu flipped faces\n",
                         validity.nonmanifold_edges, input_validity.nonmanifold_edges,

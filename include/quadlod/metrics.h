@@ -9,7 +9,9 @@
 //     from area-weighted random surface samples (plus the mesh vertices, for Hausdorff only);
 //   * QPR (Knodt 2025) with a documented rule for zero counts (`qpr_rule`);
 //   * PCCD = Chamfer distance between the poly-chords' medial curves, sampled by arc length;
-//   * flow deviation: angle between output quad edge directions and the closest input quad's.
+//   * flow deviation: angle between output quad edge directions and the closest input quad's;
+//   * features (issue 7): torn UV seams / boundaries, UV islands, UV error, material borders and
+//     feature-line deviation, from src/mesh/features.h on both meshes (docs/metrics.md §6c).
 // Everything is deterministic for a fixed seed and independent of the thread count.
 #pragma once
 
@@ -36,6 +38,13 @@ struct EvalParams {
   /// §6b: slack (normalised units, a fraction of the input's longest side) added to twice the
   /// distance of the nearest input surface before a face counts as flipped.
   double flip_tolerance = 1e-3;
+  /// §6c: an output seam / boundary edge is *torn* when one of its sample points (at ¼, ½, ¾) is
+  /// farther than feature_tolerance × (the edge's own length) from every input edge of the same
+  /// kind. A chord of an input feature line whose endpoints lie on it deviates from it by at most
+  /// tan(θ/4)/2 of its length (θ = the turn it cuts off), so 0.2 tolerates the chord error of
+  /// cutting a turn of up to 43.6° — just under FeatureParams::corner_angle_deg (45°), beyond
+  /// which a vertex is a feature corner and cutting it moves the feature.
+  double feature_tolerance = 0.2;
   /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
   /// Results do not depend on it.
   unsigned threads = 0;
@@ -98,6 +107,37 @@ struct EvalResult {
   /// centroid as the nearest input surface, plus EvalParams::flip_tolerance (docs/metrics.md §6b).
   std::uint64_t flipped_faces = 0;
 
+  // --- features, UVs, materials (issue 7; docs/metrics.md §6c) ------------------------------------
+  /// UV islands of UV set 0 with non-zero 3D area (0 when the mesh has no UVs).
+  std::uint64_t uv_islands_in = 0;
+  std::uint64_t uv_islands_out = 0;
+  /// Output edges that are UV seams (any set) or open boundaries in the output and are not within
+  /// feature_tolerance of an input edge of the same kind (see EvalParams::feature_tolerance).
+  std::uint64_t seams_torn = 0;
+  std::uint64_t seam_edges_in = 0, seam_edges_out = 0;          ///< UV seam edges (any set)
+  std::uint64_t boundary_edges_in = 0, boundary_edges_out = 0;  ///< open boundary edges
+  /// UV distance between an output sample's UV and the UV at its closest input point in the
+  /// corresponding island, over that input island's UV bbox diagonal. NaN when either mesh has no
+  /// UVs or no sample could be measured.
+  double uv_error_mean = 0.0;
+  double uv_error_max = 0.0;
+  std::uint64_t uv_samples = 0;  ///< output samples that entered uv_error
+  /// Distance (normalised units) from the sample points of output material-border edges to the
+  /// nearest input border between the same two materials (by name): max and length-weighted mean.
+  /// NaN when the output has no material border.
+  double material_border_error = 0.0;
+  double material_border_error_mean = 0.0;
+  std::uint64_t material_border_edges_out = 0;
+  /// Output samples whose face material (by name) differs from the input face's at the closest
+  /// input point, over all output samples. NaN when neither mesh has per-face materials.
+  double material_mismatch_fraction = 0.0;
+  /// Distance from the sample points of all output feature edges (any kind, FeatureParams
+  /// defaults) to the nearest input feature edge (any kind): max and length-weighted mean.
+  /// NaN when the output has no feature edge.
+  double feature_deviation_max = 0.0;
+  double feature_deviation_mean = 0.0;
+  std::uint64_t feature_edges_in = 0, feature_edges_out = 0;
+
   // --- provenance -----------------------------------------------------------------------------------
   std::uint64_t seed = 0;
   std::uint64_t samples_in = 0;          ///< surface samples drawn on the input
@@ -111,6 +151,7 @@ struct EvalResult {
   double seconds = 0.0;                  ///< wall time of evaluate()
   double seconds_distance = 0.0;         ///< sampling + BVH + surface distance queries
   double seconds_pccd = 0.0;             ///< chords + curve sampling + curve distances
+  double seconds_features = 0.0;         ///< §6c: features, islands, UV and border queries
 };
 
 /// Computes every metric of `output` against `input` (docs/metrics.md). Preconditions: both

@@ -19,14 +19,18 @@
 #include "geometry/bvh.h"
 #include "geometry/sampling.h"
 #include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "topology/polychords.h"
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <string_view>
 #include <thread>
 
 namespace quadlod {
@@ -38,6 +42,20 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 /// PCCD when exactly one mesh has medial curves (docs/metrics.md §5): the longest side of the
 /// normalised input bbox, larger than any PCCD between overlapping meshes in practice.
 constexpr double kPccdMissingCurvesPenalty = 1.0;
+/// §6c: the distance of an output feature point when the input has no feature of the kind it is
+/// compared with (the same penalty as PCCD's, for the same reason).
+constexpr double kMissingFeaturePenalty = 1.0;
+/// §6c: positions along an output edge where it is sampled (quarter points and midpoint).
+constexpr double kEdgeSampleT[3] = {0.25, 0.5, 0.75};
+/// §6c: absolute slack (normalised units) added to the torn-seam tolerance, so that a zero-length
+/// output edge lying on an input feature is not torn by rounding (1e-9 of the box, far above the
+/// ~1e-16 rounding of coordinates, far below any real displacement).
+constexpr double kTornAbsoluteSlack = 1e-9;
+/// §6c island votes: other input islands within 2·d + this slack (normalised units) of an output
+/// sample at distance d from the input compete for its vote; the slack lets exactly coincident
+/// sheets (d = 0) compete. At most this many islands are compared per sample.
+constexpr double kCoincidentSlack = 1e-9;
+constexpr int kMaxVoteCandidates = 4;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
@@ -266,6 +284,333 @@ double line_angle_deg(const Vec3& a, const Vec3& b) {
 
 Vec3 project_to_plane(const Vec3& v, const Vec3& n) { return v - v.dot(n) * n; }
 
+// --- features, UVs, materials (§6c) -------------------------------------------------------------
+
+/// Material name of face f; "" when the mesh has no materials or the face has none. §6c compares
+/// by name because the two meshes' name tables need not agree.
+std::string_view material_name(const PolyMesh& m, Index f) {
+  if (m.face_material.empty() || m.face_material[f] == kInvalidIndex) return {};
+  return m.material_names[m.face_material[f]];
+}
+
+using Segment = std::array<Vec3, 2>;
+
+Segment edge_segment(const PolyMesh& scaled, const Connectivity& conn, Index e) {
+  return {scaled.positions[conn.edge_vertices[e][0]], scaled.positions[conn.edge_vertices[e][1]]};
+}
+
+/// Distance from p to the nearest segment of `target`; the missing-feature penalty when empty.
+double feature_distance(const SegmentBvh& target, const Vec3& p) {
+  if (target.size() == 0) return kMissingFeaturePenalty;
+  return std::sqrt(target.nearest(p).distance_sq);
+}
+
+/// Everything §6c needs of one mesh: connectivity, feature edges (FeatureParams defaults) and
+/// the islands of UV set 0 (empty without UVs).
+struct MeshFeatures {
+  Connectivity conn;
+  FeatureEdges fe;
+  UvIslands islands;
+  std::uint64_t islands_with_area = 0;
+};
+
+MeshFeatures mesh_features(const PolyMesh& m) {
+  MeshFeatures r;
+  r.conn = build_connectivity(m);
+  r.fe = find_feature_edges(m, r.conn);
+  if (m.has_uvs()) {
+    r.islands = find_uv_islands(m, r.conn, 0);
+    for (double a : r.islands.area_3d) r.islands_with_area += a > 0.0;
+  }
+  return r;
+}
+
+/// Input feature edges of one kind as a segment BVH.
+template <class Keep>
+SegmentBvh feature_segments(const PolyMesh& scaled, const MeshFeatures& mf, Keep&& keep) {
+  std::vector<Segment> segs;
+  for (Index e = 0; e < mf.conn.num_edges; ++e)
+    if (keep(e)) segs.push_back(edge_segment(scaled, mf.conn, e));
+  return SegmentBvh(segs);
+}
+
+struct EdgeDeviation {
+  double max = kNaN;
+  double mean = kNaN;  ///< weighted by edge length: an arc-length average over the feature lines
+};
+
+/// Distances of the sample points (kEdgeSampleT) of output edges `edges` to `target_of(e)`.
+template <class TargetOf>
+EdgeDeviation edge_deviation(const PolyMesh& out, const Connectivity& conn,
+                             const std::vector<Index>& edges, TargetOf&& target_of) {
+  EdgeDeviation r;
+  if (edges.empty()) return r;
+  Sum weighted, length;
+  double mx = 0.0;
+  for (Index e : edges) {
+    const Segment s = edge_segment(out, conn, e);
+    const double len = (s[1] - s[0]).norm();
+    const SegmentBvh& target = target_of(e);
+    double sum = 0.0;
+    for (double t : kEdgeSampleT) {
+      const double d = feature_distance(target, s[0] + t * (s[1] - s[0]));
+      sum += d;
+      mx = std::max(mx, d);
+    }
+    weighted.add(len * sum / 3.0);
+    length.add(len);
+  }
+  r.max = mx;
+  if (length.value() > 0.0) r.mean = weighted.value() / length.value();
+  return r;
+}
+
+/// §6c seams_torn: output boundary / UV seam edges with a sample point farther than
+/// feature_tolerance × length (+ slack) from every input edge of the same kind (UV seams per set).
+std::uint64_t count_torn(const PolyMesh& in, const MeshFeatures& fin, const PolyMesh& out,
+                         const MeshFeatures& fout, double tolerance) {
+  const SegmentBvh boundary_in =
+      feature_segments(in, fin, [&](Index e) { return (fin.fe.edge_bits[e] & kFeatureBoundary) != 0; });
+  std::uint32_t out_sets = 0;
+  for (Index e = 0; e < fout.conn.num_edges; ++e) out_sets |= fout.fe.edge_uv_seam_sets[e];
+  std::vector<SegmentBvh> seams_in(32);
+  for (int k = 0; k < 32; ++k)
+    if (out_sets >> k & 1u)
+      seams_in[k] = feature_segments(in, fin, [&](Index e) { return (fin.fe.edge_uv_seam_sets[e] >> k & 1u) != 0; });
+  std::uint64_t torn = 0;
+  for (Index e = 0; e < fout.conn.num_edges; ++e) {
+    const std::uint8_t bits = fout.fe.edge_bits[e];
+    if (!(bits & (kFeatureBoundary | kFeatureUvSeam))) continue;
+    const Segment s = edge_segment(out, fout.conn, e);
+    const double tol = tolerance * (s[1] - s[0]).norm() + kTornAbsoluteSlack;
+    auto off = [&](const SegmentBvh& target) {
+      for (double t : kEdgeSampleT)
+        if (feature_distance(target, s[0] + t * (s[1] - s[0])) > tol) return true;
+      return false;
+    };
+    bool is_torn = (bits & kFeatureBoundary) && off(boundary_in);
+    for (int k = 0; k < 32 && !is_torn; ++k)
+      if (fout.fe.edge_uv_seam_sets[e] >> k & 1u) is_torn = off(seams_in[k]);
+    torn += is_torn;
+  }
+  return torn;
+}
+
+/// First fan triangle of every face in a soup (faces appear in order, degree − 2 triangles each).
+std::vector<Index> first_triangles(const TriangleSoup& soup, Index num_faces) {
+  std::vector<Index> first(num_faces, kInvalidIndex);
+  for (Index t = static_cast<Index>(soup.face.size()); t-- > 0;) first[soup.face[t]] = t;
+  return first;
+}
+
+/// UV (set 0) at point p of fan triangle t: barycentric interpolation of the triangle's corner
+/// UVs, the weights clamped to [0, 1] and renormalised so that rounding on a sliver cannot
+/// extrapolate beyond the triangle's UVs. Every corner of the face must have a UV.
+Vec2 uv_at(const PolyMesh& m, const TriangleSoup& soup, const std::vector<Index>& first, Index t,
+           const Vec3& p) {
+  const Index f = soup.face[t];
+  const Index i = t - first[f];
+  const Index b = m.face_begin(f);
+  const Index corners[3] = {b, b + i + 1, b + i + 2};
+  const auto& tri = soup.triangles[t];
+  const Vec3 e0 = tri[1] - tri[0], e1 = tri[2] - tri[0], q = p - tri[0];
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = q.dot(e0), d21 = q.dot(e1);
+  const double den = d00 * d11 - d01 * d01;
+  double w[3] = {1.0, 0.0, 0.0};
+  if (den > 0.0) {
+    w[1] = std::clamp((d11 * d20 - d01 * d21) / den, 0.0, 1.0);
+    w[2] = std::clamp((d00 * d21 - d01 * d20) / den, 0.0, 1.0);
+    w[0] = std::max(0.0, 1.0 - w[1] - w[2]);
+    const double sum = w[0] + w[1] + w[2];
+    for (double& x : w) x /= sum;
+  }
+  const UvSet& set = m.uv_sets[0];
+  Vec2 uv = Vec2::Zero();
+  for (int k = 0; k < 3; ++k) uv += w[k] * set.values[set.corner[corners[k]]];
+  return uv;
+}
+
+struct UvErrorResult {
+  double mean = kNaN, max = kNaN;
+  std::uint64_t samples = 0;
+};
+
+/// §6c uv_error over the output samples: output island → the input island most of its samples
+/// vote for; then the closest point within that island (positive-area triangles only) and the UV
+/// distance over the island's UV bbox diagonal.
+UvErrorResult uv_error(const PolyMesh& input, const PolyMesh& output, const MeshFeatures& fin,
+                       const MeshFeatures& fout, const TriangleSoup& soup_in,
+                       const TriangleSoup& soup_out, const SurfaceSamples& s_out,
+                       const Directed& d_out, const TriangleBvh& bvh_in, unsigned threads) {
+  UvErrorResult r;
+  const std::size_t n = s_out.points.size();
+  std::vector<Index> tri_island(soup_in.triangles.size(), kInvalidIndex);
+  for (std::size_t t = 0; t < tri_island.size(); ++t)
+    if (triangle_area(soup_in.triangles[t]) > 0.0) tri_island[t] = fin.islands.face_island[soup_in.face[t]];
+  const std::vector<Index> first_in = first_triangles(soup_in, input.num_faces());
+  const std::vector<Index> first_out = first_triangles(soup_out, output.num_faces());
+  std::vector<Index> out_island(n, kInvalidIndex), vote(n, kInvalidIndex);
+  std::vector<Vec2> uv_out(n, Vec2::Zero());
+  const std::vector<std::uint32_t> order = morton_order(s_out.points, {});
+
+  // Votes. A sample votes for the island of its closest input point; when other islands are
+  // nearly as close (within 2·d + kCoincidentSlack: coincident twin sheets, two-sided panels,
+  // both sides of a seam) it votes for the one whose UV there is nearest its own UV, so that a
+  // duplicated sheet cannot capture an island by the BVH's tie order.
+  parallel_chunks(order.size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::size_t k = order[j];
+      out_island[k] = fout.islands.face_island[soup_out.face[s_out.triangle[k]]];
+      const Index t0 = d_out.nearest[k];
+      if (out_island[k] == kInvalidIndex || t0 == kInvalidIndex) continue;
+      uv_out[k] = uv_at(output, soup_out, first_out, s_out.triangle[k], s_out.points[k]);
+      if (tri_island[t0] == kInvalidIndex) continue;
+      const Vec3& p = s_out.points[k];
+      const double bound = 2.0 * d_out.dist[k] + kCoincidentSlack;
+      const auto& tri = soup_in.triangles[t0];
+      Index best = tri_island[t0];
+      double best_uv = (uv_at(input, soup_in, first_in, t0, closest_point_on_triangle(p, tri[0], tri[1], tri[2]).point) -
+                        uv_out[k]).squaredNorm();
+      Index seen[kMaxVoteCandidates] = {best};
+      for (int c = 1; c < kMaxVoteCandidates; ++c) {
+        const NearestHit h = bvh_in.nearest_if(
+            p, [&](Index t) { return tri_island[t] != kInvalidIndex && std::find(seen, seen + c, tri_island[t]) == seen + c; },
+            kInvalidIndex, bound * bound);
+        if (h.primitive == kInvalidIndex) break;
+        seen[c] = tri_island[h.primitive];
+        const double d_uv = (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv_out[k]).squaredNorm();
+        if (d_uv < best_uv || (d_uv == best_uv && seen[c] < best)) {
+          best_uv = d_uv;
+          best = seen[c];
+        }
+      }
+      vote[k] = best;
+    }
+  });
+  std::vector<std::pair<Index, Index>> votes;  // (output island, input island), tallied serially
+  for (std::size_t k = 0; k < n; ++k)
+    if (vote[k] != kInvalidIndex) votes.emplace_back(out_island[k], vote[k]);
+  std::sort(votes.begin(), votes.end());
+  std::vector<Index> target(fout.islands.num_islands, kInvalidIndex);
+  std::vector<std::size_t> most(fout.islands.num_islands, 0);
+  for (std::size_t a = 0, b; a < votes.size(); a = b) {
+    for (b = a; b < votes.size() && votes[b] == votes[a]; ++b) {}
+    // Strictly more votes wins; ties keep the smaller input island (seen first in sorted order).
+    if (b - a > most[votes[a].first]) {
+      most[votes[a].first] = b - a;
+      target[votes[a].first] = votes[a].second;
+    }
+  }
+
+  std::vector<double> err(n, kNaN);
+  parallel_chunks(order.size(), threads, [&](std::size_t begin, std::size_t end) {
+    Index hint = kInvalidIndex;
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::size_t k = order[j];
+      if (out_island[k] == kInvalidIndex) continue;
+      const Index ii = target[out_island[k]];
+      if (ii == kInvalidIndex) continue;
+      const double diag = (fin.islands.uv_max[ii] - fin.islands.uv_min[ii]).norm();
+      if (!(diag > 0.0)) continue;
+      auto in_island = [&](Index t) { return tri_island[t] == ii; };
+      const Index t0 = d_out.nearest[k];
+      const NearestHit h = bvh_in.nearest_if(s_out.points[k], in_island,
+                                             t0 != kInvalidIndex && in_island(t0) ? t0 : hint);
+      if (h.primitive == kInvalidIndex) continue;
+      hint = h.primitive;
+      err[k] = (uv_out[k] - uv_at(input, soup_in, first_in, h.primitive, h.point)).norm() / diag;
+    }
+  });
+  Sum s;
+  double mx = 0.0;
+  for (double e : err) {
+    if (std::isnan(e)) continue;
+    s.add(e);
+    mx = std::max(mx, e);
+    ++r.samples;
+  }
+  if (r.samples) {
+    r.mean = s.value() / static_cast<double>(r.samples);
+    r.max = mx;
+  }
+  return r;
+}
+
+/// §6c: every metric of the features section, on the scaled copies (in, out) for geometry and the
+/// originals (input, output) for UVs and materials; the same vertex and face ids.
+void feature_metrics(const PolyMesh& input, const PolyMesh& output, const PolyMesh& in,
+                     const PolyMesh& out, const TriangleSoup& soup_in, const TriangleSoup& soup_out,
+                     const SurfaceSamples& s_out, const Directed& d_out, const TriangleBvh& bvh_in,
+                     const EvalParams& params, unsigned threads, EvalResult& r) {
+  const std::vector<Index>& nearest_in = d_out.nearest;
+  MeshFeatures fin, fout;
+  run_both(
+      threads, [&] { fin = mesh_features(input); }, [&] { fout = mesh_features(output); });
+  r.uv_islands_in = fin.islands_with_area;
+  r.uv_islands_out = fout.islands_with_area;
+  const int seam = std::countr_zero(unsigned{kFeatureUvSeam});
+  const int boundary = std::countr_zero(unsigned{kFeatureBoundary});
+  r.seam_edges_in = fin.fe.edges_with_bit[seam];
+  r.seam_edges_out = fout.fe.edges_with_bit[seam];
+  r.boundary_edges_in = fin.fe.edges_with_bit[boundary];
+  r.boundary_edges_out = fout.fe.edges_with_bit[boundary];
+  r.feature_edges_in = fin.fe.feature_edges;
+  r.feature_edges_out = fout.fe.feature_edges;
+
+  r.seams_torn = count_torn(in, fin, out, fout, params.feature_tolerance);
+
+  r.uv_error_mean = r.uv_error_max = kNaN;
+  if (input.has_uvs() && output.has_uvs()) {
+    const UvErrorResult u =
+        uv_error(input, output, fin, fout, soup_in, soup_out, s_out, d_out, bvh_in, threads);
+    r.uv_error_mean = u.mean;
+    r.uv_error_max = u.max;
+    r.uv_samples = u.samples;
+  }
+
+  // Material borders, keyed by the unordered pair of names.
+  using Pair = std::pair<std::string, std::string>;
+  auto pair_of = [](const PolyMesh& m, const MeshFeatures& mf, Index e) {
+    const auto cs = mf.conn.corners_of_edge(e);
+    std::string a(material_name(m, mf.conn.corner_face[cs[0]])), b(material_name(m, mf.conn.corner_face[cs[1]]));
+    return a < b ? Pair{a, b} : Pair{b, a};
+  };
+  std::map<Pair, std::vector<Segment>> border_segments;
+  for (Index e = 0; e < fin.conn.num_edges; ++e)
+    if (fin.fe.edge_bits[e] & kFeatureMaterialBorder)
+      border_segments[pair_of(input, fin, e)].push_back(edge_segment(in, fin.conn, e));
+  std::map<Pair, SegmentBvh> borders_in;
+  for (const auto& [key, segs] : border_segments) borders_in.emplace(key, SegmentBvh(segs));
+  std::vector<Index> border_out, feature_out;
+  for (Index e = 0; e < fout.conn.num_edges; ++e) {
+    if (fout.fe.edge_bits[e] & kFeatureMaterialBorder) border_out.push_back(e);
+    if (fout.fe.edge_bits[e]) feature_out.push_back(e);
+  }
+  r.material_border_edges_out = border_out.size();
+  const SegmentBvh none;
+  const EdgeDeviation border = edge_deviation(out, fout.conn, border_out, [&](Index e) -> const SegmentBvh& {
+    const auto it = borders_in.find(pair_of(output, fout, e));
+    return it == borders_in.end() ? none : it->second;
+  });
+  r.material_border_error = border.max;
+  r.material_border_error_mean = border.mean;
+
+  r.material_mismatch_fraction = kNaN;
+  if (!input.face_material.empty() || !output.face_material.empty()) {
+    std::uint64_t mismatched = 0;
+    for (std::size_t k = 0; k < s_out.points.size(); ++k)
+      mismatched += material_name(output, soup_out.face[s_out.triangle[k]]) !=
+                    material_name(input, soup_in.face[nearest_in[k]]);
+    r.material_mismatch_fraction = static_cast<double>(mismatched) / static_cast<double>(s_out.points.size());
+  }
+
+  const SegmentBvh features_in = feature_segments(in, fin, [&](Index e) { return fin.fe.is_feature(e); });
+  const EdgeDeviation dev =
+      edge_deviation(out, fout.conn, feature_out, [&](Index) -> const SegmentBvh& { return features_in; });
+  r.feature_deviation_max = dev.max;
+  r.feature_deviation_mean = dev.mean;
+}
+
 }  // namespace
 
 // --- face counts and QPR (§4) ------------------------------------------------------------------------
@@ -325,6 +670,8 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
     r.qpr = r.quad_fraction_in = r.quad_fraction_out = kNaN;
     r.pccd = r.pccd_in_to_out = r.pccd_out_to_in = kNaN;
     r.flow_deviation_deg = r.flow_deviation_p90_deg = r.flow_coverage = kNaN;
+    r.uv_error_mean = r.uv_error_max = r.material_border_error = r.material_border_error_mean = kNaN;
+    r.material_mismatch_fraction = r.feature_deviation_max = r.feature_deviation_mean = kNaN;
     r.seconds = seconds_since(t0);
     return r;
   };
@@ -456,6 +803,11 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
     }
   }
 
+  // §6c features, UVs, materials.
+  const auto t_features = Clock::now();
+  feature_metrics(input, output, in, out, soup_in, soup_out, s_out, d_out, bvh_in, params, threads, r);
+  r.seconds_features = seconds_since(t_features);
+
   // §5 PCCD.
   const auto t_pccd = Clock::now();
   Curves c_in, c_out;
@@ -535,6 +887,24 @@ nlohmann::json to_json(const EvalResult& r) {
   j["flow_deviation_p90_deg"] = num(r.flow_deviation_p90_deg);
   j["flow_coverage"] = num(r.flow_coverage);
   j["flipped_faces"] = r.flipped_faces;
+  j["uv_islands_in"] = r.uv_islands_in;
+  j["uv_islands_out"] = r.uv_islands_out;
+  j["seams_torn"] = r.seams_torn;
+  j["seam_edges_in"] = r.seam_edges_in;
+  j["seam_edges_out"] = r.seam_edges_out;
+  j["boundary_edges_in"] = r.boundary_edges_in;
+  j["boundary_edges_out"] = r.boundary_edges_out;
+  j["uv_error_mean"] = num(r.uv_error_mean);
+  j["uv_error_max"] = num(r.uv_error_max);
+  j["uv_samples"] = r.uv_samples;
+  j["material_border_error"] = num(r.material_border_error);
+  j["material_border_error_mean"] = num(r.material_border_error_mean);
+  j["material_border_edges_out"] = r.material_border_edges_out;
+  j["material_mismatch_fraction"] = num(r.material_mismatch_fraction);
+  j["feature_deviation_max"] = num(r.feature_deviation_max);
+  j["feature_deviation_mean"] = num(r.feature_deviation_mean);
+  j["feature_edges_in"] = r.feature_edges_in;
+  j["feature_edges_out"] = r.feature_edges_out;
   j["seed"] = r.seed;
   j["samples_in"] = r.samples_in;
   j["samples_out"] = r.samples_out;
@@ -547,6 +917,7 @@ nlohmann::json to_json(const EvalResult& r) {
   j["seconds"] = num(r.seconds);
   j["seconds_distance"] = num(r.seconds_distance);
   j["seconds_pccd"] = num(r.seconds_pccd);
+  j["seconds_features"] = num(r.seconds_features);
   return j;
 }
 

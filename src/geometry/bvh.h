@@ -191,11 +191,14 @@ class TriangleBvh {
   /// which prunes more; the distance found does not depend on it (ties may pick another id).
   NearestHit nearest(const Vec3& p, Index hint = kInvalidIndex) const;
   /// The same among the triangles whose id passes `accept` (a predicate on the original id);
-  /// `hint`, if it passes, seeds the search as for nearest().
+  /// `hint`, if it passes, seeds the search as for nearest(). Only triangles strictly nearer than
+  /// sqrt(max_distance_sq) count (none found: primitive = kInvalidIndex); a finite bound keeps a
+  /// search that rejects the nearby triangles from opening the whole tree.
   template <class Accept>
-  NearestHit nearest_if(const Vec3& p, Accept&& accept, Index hint = kInvalidIndex) const {
+  NearestHit nearest_if(const Vec3& p, Accept&& accept, Index hint = kInvalidIndex,
+                        double max_distance_sq = std::numeric_limits<double>::infinity()) const {
     NearestHit hit;
-    double best_d2 = std::numeric_limits<double>::infinity();
+    double best_d2 = max_distance_sq;
     auto consider = [&](Index i) {
       const TrianglePoint tp = closest_point_on_triangle(frames_[i], p);
       if (tp.distance_sq < best_d2) {
