@@ -3,6 +3,7 @@
 // quadric), then the guarantees as invariants over random selections on the generated meshes.
 #include "post/cluster_collapse.h"
 
+#include "geometry/bvh.h"
 #include "mesh/connectivity.h"
 #include "mesh/validation.h"
 #include "feature_test_util.h"
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -635,6 +637,55 @@ TEST(ClusterCollapseFeatures, NormalsAreRecomputedPerSideAndStayHard) {
     for (Index c = r.mesh.face_begin(f); c < r.mesh.face_end(f); ++c)
       EXPECT_LT((r.mesh.normals[r.mesh.corner_normal[c]] - n).norm(), 1e-9) << "face " << f;
   }
+}
+
+// An annulus sector: radial lines i = 0..7 at 40° steps, rings r = 1, 1.5, 2 (j = 0..2). The arcs
+// turn by 40° per vertex, less than corner_angle_deg, so each arc is one boundary line without
+// corners in between. Collapsing columns 2, 3, 4 merges radial lines 2..5 into one: whatever the
+// placement, an output arc edge then spans 2.5 or more input segments (a turn of 100°+), whose
+// chord leaves the arc by more than 0.2 of its length — refused as `feature`. With a lax tolerance
+// it goes through.
+TEST(ClusterCollapseFeatures, ChordCuttingACurvedBoundaryTooShortIsRefused) {
+  PolyMesh in;
+  const Index n = 8, rings = 3;
+  for (Index j = 0; j < rings; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const double a = i * 40.0 * std::numbers::pi / 180.0, r = 1.0 + 0.5 * j;
+      in.add_vertex(Vec3(r * std::cos(a), r * std::sin(a), 0.0));
+    }
+  auto id = [&](Index i, Index j) { return j * n + i; };
+  for (Index j = 0; j + 1 < rings; ++j)
+    for (Index i = 0; i + 1 < n; ++i) in.add_face({id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)});
+  const Connectivity conn = build_connectivity(in);
+  std::vector<std::pair<Index, Index>> chords;
+  for (Index i = 2; i <= 4; ++i)
+    for (Index j = 0; j < rings; ++j) chords.emplace_back(id(i, j), id(i + 1, j));
+
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chords));
+  expect_valid_output(in, r);
+  EXPECT_GE(r.stats.refusals(CollapseRefusal::Feature), 1u);
+  // Every output boundary edge stays within 0.2 of its length of the input boundary.
+  const Connectivity out = build_connectivity(r.mesh);
+  for (Index e = 0; e < out.num_edges; ++e) {
+    if (!out.is_boundary_edge(e)) continue;
+    const Vec3 &a = r.mesh.positions[out.edge_vertices[e][0]], &b = r.mesh.positions[out.edge_vertices[e][1]];
+    for (double t : {0.25, 0.5, 0.75}) {
+      const Vec3 p = a + t * (b - a);
+      double best = INFINITY;
+      for (Index f = 0; f < conn.num_edges; ++f)
+        if (conn.is_boundary_edge(f))
+          best = std::min(best, (closest_point_on_segment(p, in.positions[conn.edge_vertices[f][0]],
+                                                          in.positions[conn.edge_vertices[f][1]]) - p).norm());
+      EXPECT_LE(best, 0.2 * (b - a).norm() + 1e-12) << "output edge " << e;
+    }
+  }
+
+  ClusterCollapseParams lax;
+  lax.feature_tolerance = 1.0;
+  const ClusterCollapseResult l = collapse_clusters(in, conn, select(conn, chords), lax);
+  expect_valid_output(in, l);
+  EXPECT_EQ(l.stats.refusals(CollapseRefusal::Feature), 0u);
+  EXPECT_EQ(l.mesh.num_faces(), 2u * (n - 1) - 6u);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "mesh/validation.h"
 #include "quadlod/generators.h"
 #include "quadlod/io.h"
+#include "quadlod/metrics.h"
 #include "quadlod/simplify.h"
 #include "topology/polychords.h"
 
@@ -131,6 +132,51 @@ TEST(Simplify, RoundsPinRefusedCollapsesAndReAim) {
   const double dev_b = std::abs(double(b.achieved) - double(b.target));
   EXPECT_LE(dev_b, dev_a);  // the best round is kept, so more rounds never do worse
   EXPECT_EQ(a.report["rounds"].size(), 1u);
+}
+
+TEST(Simplify, LargeReductionsRunInPassesOfEqualRatio) {
+  // 0.2 with pass_ratio 0.5: k = ⌈log 0.2 / log 0.5⌉ = 3 planned passes aiming at N0·0.2^(i/3).
+  const PolyMesh torus = make_torus(32, 20);
+  const SimplifyResult r = simplify(torus, quick(0.2));
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.report["passes_planned"].get<int>(), 3);
+  const auto& passes = r.report["passes"];
+  ASSERT_GE(passes.size(), 1u);
+  const double n0 = double(r.input_tri_equivalent), n = double(r.target);
+  for (std::size_t i = 0; i + 1 < passes.size() && i < 2; ++i)
+    EXPECT_EQ(passes[i]["target"].get<std::uint64_t>(),
+              static_cast<std::uint64_t>(std::llround(n0 * std::pow(n / n0, double(i + 1) / 3))));
+  // Each pass starts from the previous one's output.
+  for (std::size_t i = 1; i < passes.size(); ++i)
+    EXPECT_EQ(passes[i]["input_tri_equivalent"], passes[i - 1]["achieved"]);
+  EXPECT_EQ(r.passes_used, static_cast<int>(passes.size()));
+  const double dev = std::abs(double(r.achieved) - n) / n;
+  if (dev > 0.03) EXPECT_FALSE(r.note.empty());
+  expect_valid(torus, r.mesh, "torus 0.2");
+  // One pass is the paper's single selection.
+  SimplifyOptions one = quick(0.2);
+  one.max_passes = 1;
+  const SimplifyResult s = simplify(torus, one);
+  ASSERT_TRUE(s.ok()) << s.error;
+  EXPECT_EQ(s.passes_used, 1);
+  EXPECT_EQ(s.report["passes"].size(), 1u);
+}
+
+TEST(Simplify, UvSeamsSurviveAndUvsFollowTheMovedVertices) {
+  // The demo vase has a cylindrical chart with a seam, a disc chart and an n-gon lid chart.
+  const PolyMesh vase = make_demo_vase(24, 16);
+  for (double ratio : {0.5, 0.25}) {
+    const SimplifyResult r = simplify(vase, quick(ratio));
+    ASSERT_TRUE(r.ok()) << r.error;
+    EvalParams ep;
+    ep.samples = 20000;
+    const EvalResult e = evaluate(vase, r.mesh, ep);
+    ASSERT_TRUE(e.ok()) << e.error;
+    EXPECT_EQ(e.seams_torn, 0u) << ratio;
+    EXPECT_EQ(e.uv_islands_out, e.uv_islands_in) << ratio;
+    EXPECT_LT(e.uv_error_mean, 0.01) << ratio;
+    EXPECT_GT(r.report["collapse"]["uv_values_projected"].get<Index>(), 0u) << ratio;
+  }
 }
 
 TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {

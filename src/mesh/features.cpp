@@ -75,7 +75,6 @@ double angle_deg(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).no
 FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
                                 const FeatureParams& params) {
   FeatureEdges fe;
-  fe.strict_bits = params.strict;
   const Index ne = conn.num_edges, nv = conn.num_vertices;
   fe.edge_bits.assign(ne, 0);
   fe.edge_uv_seam_sets.assign(ne, 0);
@@ -215,6 +214,37 @@ FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
     walk(smallest, incident[offsets[smallest]], fe.num_lines++);
   }
   for (Index v = 0; v < nv; ++v) fe.corners += fe.vertex_corner[v];
+
+  // --- strictness ----------------------------------------------------------------------------
+  // A UV set whose islands are mostly single faces (more than per_face_layout_fraction of its
+  // faces are alone in their island: the OpenSubdiv cages' per-face UVs) can only be reduced by
+  // letting islands vanish, so its seams are placement seams, not strict ones.
+  std::uint32_t strict_sets = 0;
+  if (params.strict & kFeatureUvSeam)
+    for (std::size_t k = 0; k < mesh.uv_sets.size() && k < 32; ++k) {
+      const UvIslands islands = find_uv_islands(mesh, conn, static_cast<Index>(k));
+      std::vector<Index> size(islands.num_islands, 0);
+      Index with_uv = 0, alone = 0;
+      for (Index f = 0; f < mesh.num_faces(); ++f)
+        if (islands.face_island[f] != kInvalidIndex) ++size[islands.face_island[f]];
+      for (Index f = 0; f < mesh.num_faces(); ++f) {
+        if (islands.face_island[f] == kInvalidIndex) continue;
+        ++with_uv;
+        alone += size[islands.face_island[f]] == 1;
+      }
+      if (!(double(alone) > params.per_face_layout_fraction * double(with_uv))) strict_sets |= 1u << k;
+    }
+  fe.edge_strict.assign(ne, 0);
+  fe.vertex_strict.assign(nv, 0);
+  for (Index e = 0; e < ne; ++e) {
+    std::uint8_t strict = fe.edge_bits[e] & params.strict;
+    if ((strict & kFeatureUvSeam) && !(fe.edge_uv_seam_sets[e] & strict_sets))
+      strict &= static_cast<std::uint8_t>(~kFeatureUvSeam);
+    if (!strict) continue;
+    fe.edge_strict[e] = 1;
+    ++fe.strict_edges;
+    for (Index v : conn.edge_vertices[e]) fe.vertex_strict[v] = 1;
+  }
   return fe;
 }
 

@@ -13,15 +13,15 @@
 // Only manifold interior edges can be seams, borders or hard edges; boundary and non-manifold
 // edges carry their own bit.
 //
-// *Strict* features (boundary, non-manifold, material border) separate things that must stay
-// separate: two strict feature points may only merge when they are neighbours along one strict
-// line, otherwise a hole would be pinched shut, a thin open part would vanish, or two materials
-// would meet along a border the input does not have. UV seams, normal seams and hard edges are
-// *placement* features: a merged vertex that touches one line stays on it, but two such lines may
-// merge (a bevel between two creases, or a one-quad strip between two UV seams, may collapse at a
-// coarse LOD). A UV seam cannot tear that way: every output corner takes its UV from the chart of
-// the input face it comes from (cluster_collapse.h, point 5), so the two sides keep distinct UVs.
-// The measurements behind this split are in docs/attributes.md.
+// *Strict* features (boundary, non-manifold, UV seam, material border) separate things that
+// must stay separate: two strict feature points may only merge when they are neighbours along one
+// strict line, otherwise a seam would tear (one island's UVs meeting another's off their common
+// seam), a hole would be pinched shut, a thin open part would vanish, or two materials would meet
+// along a border the input does not have. Exception: the seams of a per-face UV layout (most faces
+// alone in their island) are not strict: such a mesh must lose islands to be reduced at all.
+// Hard edges and normal seams are *placement* features: a merged vertex that touches one such
+// line stays on it, but two such lines may merge (a bevel between two creases may collapse at a
+// coarse LOD). The measurements behind this split are in docs/attributes.md.
 //
 // Feature *lines* are maximal chains of feature edges between feature corners. A vertex is a
 // feature corner when its number of incident feature edges is not 2 (an endpoint or a junction),
@@ -50,7 +50,7 @@ enum FeatureBit : std::uint8_t {
 };
 /// Features that must never be merged with a different feature line (see above).
 inline constexpr std::uint8_t kStrictFeatures =
-    kFeatureBoundary | kFeatureNonManifold | kFeatureMaterialBorder;
+    kFeatureBoundary | kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
 inline constexpr std::uint8_t kAllFeatures = 0x3f;
 
 struct FeatureParams {
@@ -66,10 +66,14 @@ struct FeatureParams {
   std::uint8_t enabled = kAllFeatures;
   /// Which bits are strict (never merged with another line; see above).
   std::uint8_t strict = kStrictFeatures;
+  /// A UV set in which more than this fraction of the faces are alone in their island is a
+  /// per-face layout (the OpenSubdiv cages): it can only be reduced by letting islands vanish, so
+  /// its seams are placement seams, not strict ones. Corpus: 1.00 on the two cages, at most 0.06
+  /// on every other mesh (docs/attributes.md).
+  double per_face_layout_fraction = 0.5;
 };
 
 struct FeatureEdges {
-  std::uint8_t strict_bits = kStrictFeatures;    ///< FeatureParams::strict (what is_strict tests)
   std::vector<std::uint8_t> edge_bits;           ///< per Connectivity edge, OR of FeatureBit
   std::vector<std::uint32_t> edge_uv_seam_sets;  ///< per edge: bit k = seam in UV set k (k < 32)
   std::vector<std::uint8_t> vertex_bits;         ///< per vertex, OR over its incident edges
@@ -81,11 +85,14 @@ struct FeatureEdges {
   std::array<Index, 6> edges_with_bit{};
   Index feature_edges = 0;
   Index corners = 0;
+  /// Strictness (see above): per edge, and per vertex (on a strict edge); strict edges in total.
+  std::vector<std::uint8_t> edge_strict, vertex_strict;
+  Index strict_edges = 0;
 
   bool is_feature(Index e) const { return edge_bits[e] != 0; }
-  bool is_strict(Index e) const { return (edge_bits[e] & strict_bits) != 0; }
+  bool is_strict(Index e) const { return edge_strict[e] != 0; }
   bool on_feature(Index v) const { return vertex_bits[v] != 0; }
-  bool on_strict(Index v) const { return (vertex_bits[v] & strict_bits) != 0; }
+  bool on_strict(Index v) const { return vertex_strict[v] != 0; }
 };
 
 /// Classifies every edge of `conn` (built from `mesh`). Linear in the corners.

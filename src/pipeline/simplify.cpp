@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numbers>
 #include <optional>
 
@@ -377,7 +376,6 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
   cp.features.hard_angle_deg = options.hard_angle_deg;
-  if (const char* en = std::getenv("QL_ENABLED")) cp.features.enabled = static_cast<std::uint8_t>(std::atoi(en));
 
   // Passes (beyond the paper). One global selection can remove only so much: at 20 % of a
   // low-poly character, the clusters of one selection grow so large that the collapse refuses

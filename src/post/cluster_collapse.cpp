@@ -89,6 +89,7 @@ class Collapser {
   void place(Index r);
   bool place_on_feature(Index r, const Quadric& q);
   bool features_valid(Index r);
+  void check_feature_edges(Index v);
   void split(Index r, CollapseRefusal why, bool dissolve);
 
   // --- faces -----------------------------------------------------------------------------------
@@ -938,6 +939,54 @@ void Collapser::check_vertex(Index v) {
   }
 
   if (hausdorff_tol_ > 0.0 && cluster_size(v) > 1 && placed_round_[v] == round_) check_hausdorff(v);
+  if (features_on_ && cluster_size(v) > 1) check_feature_edges(v);
+}
+
+// Output edges that continue a strict feature line must stay on it: every output edge v–w that
+// comes from an input strict feature edge between the two clusters is sampled at ¼, ½, ¾, and each
+// sample must lie within feature_tolerance · |v w| of the strict feature edges around the two
+// clusters (the input polyline the output edge replaces). This is the rule `quadlod eval` counts
+// as `seams_torn` (docs/metrics.md §6c); a chord that cuts a curved seam or boundary too short
+// is refused here instead. Uses nbr_ of check_vertex.
+void Collapser::check_feature_edges(Index v) {
+  bool strict_member = false;
+  for (Index m : members(v)) strict_member = strict_member || feat_.on_strict(m);
+  if (!strict_member) return;
+  const double tol = std::max(0.0, params_.feature_tolerance);
+  for (std::size_t i = 0; i < nbr_.size(); ++i) {
+    const Index w = nbr_[i].first;
+    if (i > 0 && nbr_[i - 1].first == w) continue;
+    // Input strict feature edges between the clusters, and the strict segments around both.
+    bool continues_line = false;
+    edges_tmp_.clear();
+    for (Index r : {v, w})
+      for (Index m : members(r))
+        for (Index c : conn_.corners_at_vertex(m))
+          for (Index ec : {c, conn_.corner_prev[c]}) {
+            const Index e = conn_.corner_edge[ec];
+            if (!feat_.is_strict(e)) continue;
+            edges_tmp_.push_back(e);
+            const Index o = root_[conn_.other_vertex(e, m)];
+            continues_line = continues_line || (r == v && o == w);
+          }
+    if (!continues_line) continue;
+    const Vec3 &a = pos_[v], &b = pos_[w];
+    const double len = (b - a).norm();
+    bool ok = true;
+    for (double t : {0.25, 0.5, 0.75}) {
+      const Vec3 p = a + t * (b - a);
+      double best = INFINITY;
+      for (Index e : edges_tmp_) {
+        const auto [x, y] = conn_.edge_vertices[e];
+        best = std::min(best, (closest_point_on_segment(p, mesh_.positions[x], mesh_.positions[y]) - p).norm());
+      }
+      ok = ok && best <= tol * len + 1e-12 * diag_;
+    }
+    if (!ok) {
+      blame(v, CollapseRefusal::Feature);
+      blame(w, CollapseRefusal::Feature);
+    }
+  }
 }
 
 // One-sided distance bound (documented approximation of the Hausdorff distance): the placed vertex

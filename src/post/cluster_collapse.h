@@ -111,6 +111,11 @@ struct ClusterCollapseParams {
   /// Re-project UVs and recompute normals of moved vertices per wedge (point 5 above). false:
   /// every surviving corner keeps its own input UV / normal index (UVs then stretch).
   bool project_attributes = true;
+  /// An output edge continuing a strict feature line (boundary, UV seam, material border) may
+  /// leave the input line by at most this fraction of its own length (sampled at ¼, ½, ¾): the
+  /// tolerance `quadlod eval` uses for `seams_torn` (docs/metrics.md §6c). 0.2 forgives a chord
+  /// over a turn of up to 43.6°, just under FeatureParams::corner_angle_deg.
+  double feature_tolerance = 0.2;
 
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
@@ -129,7 +134,8 @@ enum class CollapseRefusal : std::uint8_t {
   Flip,               ///< an output face turned more than flip_angle_deg from its input face
   FoldedCorner,       ///< a convex polygon corner became reflex
   Hausdorff,          ///< the placed vertex left the max_hausdorff band around the input
-  Feature,            ///< the cluster joins two strict feature lines or two strict corners
+  Feature,            ///< the cluster joins two strict feature lines or two strict corners, or
+                      ///< an output edge leaves the strict line it continues (feature_tolerance)
 };
 inline constexpr std::size_t kNumCollapseRefusals = 9;
 const char* to_string(CollapseRefusal reason);
