@@ -96,7 +96,9 @@ TEST(Features, CylinderUnwrappedWithOneSeam) {
   for (Index j = 0; j < m; ++j) {
     const Index a = j * n, b = (j + 1) * n;  // vertex i = 0 on rings j, j + 1
     for (Index e = 0; e < f.conn.num_edges; ++e)
-      if (f.conn.edge_vertices[e] == std::array<Index, 2>{a, b}) EXPECT_EQ(f.fe.edge_bits[e], kFeatureUvSeam);
+      if (f.conn.edge_vertices[e] == std::array<Index, 2>{a, b}) {
+        EXPECT_EQ(f.fe.edge_bits[e], kFeatureUvSeam);
+      }
   }
   // Ring vertices turn by 30° < 45°: the only corners are the seam's ends (valence 3), which also
   // anchor the two boundary rings. Lines: the seam and each ring.
@@ -291,18 +293,23 @@ TEST(Features, SmoothingGroupsAndNormalSeams) {
 }
 
 TEST(Features, NonManifoldEdgeCarriesItsOwnBit) {
+  // A "book" of three unit quads around the spine (0,0,0)-(0,0,1), pages 120° apart.
   PolyMesh m;
   m.add_vertex(Vec3(0, 0, 0));
-  m.add_vertex(Vec3(1, 0, 0));
-  m.add_vertex(Vec3(0, 1, 0));
-  m.add_vertex(Vec3(0, -1, 0));
   m.add_vertex(Vec3(0, 0, 1));
-  m.add_face({0, 1, 2});
-  m.add_face({1, 0, 3});
-  m.add_face({0, 1, 4});
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / 3.0;
+    const Index p = m.add_vertex(Vec3(std::cos(a), std::sin(a), 0));
+    m.add_vertex(Vec3(std::cos(a), std::sin(a), 1));
+    m.add_face({0, p, p + 1, 1});
+  }
   const Found f = features_of(m);
   EXPECT_EQ(bit_count(f.fe, kFeatureNonManifold), 1u);
-  EXPECT_EQ(bit_count(f.fe, kFeatureBoundary), 6u);
+  EXPECT_EQ(bit_count(f.fe, kFeatureBoundary), 9u);
   EXPECT_EQ(bit_count(f.fe, kFeatureHardEdge), 0u);  // only manifold edges can be hard
-  EXPECT_TRUE(f.fe.is_strict(f.conn.corner_edge[0]));
+  const Index spine = f.conn.corner_edge[m.face_begin(0) + 3];
+  EXPECT_EQ(f.fe.edge_bits[spine], kFeatureNonManifold);
+  EXPECT_TRUE(f.fe.is_strict(spine));
+  // Spine ends: valence 4 (the spine and three page edges): corners; page corners turn 90°.
+  EXPECT_EQ(f.fe.corners, 8u);
 }
