@@ -1,6 +1,8 @@
 // Runs the quadlod executable from tests and captures its exit code, stdout and stderr.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -48,6 +50,14 @@ inline CliRun run_cli(const std::string& args, const std::filesystem::path& scra
   std::filesystem::remove(err);
   return run;
 }
+
+/// A fixture owning a fresh scratch directory named after the running test, removed afterwards.
+class ScratchDirTest : public ::testing::Test {
+ protected:
+  void SetUp() override { dir = scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name()); }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+  std::filesystem::path dir;
+};
 
 inline void write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;

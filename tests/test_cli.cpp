@@ -22,14 +22,7 @@ void expect_one_line_error(const CliRun& run, const std::string& must_contain) {
   EXPECT_NE(run.err.find(must_contain), std::string::npos) << run.err;
 }
 
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir = scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-  }
-  void TearDown() override { fs::remove_all(dir); }
-  fs::path dir;
-};
+class CliTest : public ScratchDirTest {};
 
 }  // namespace
 

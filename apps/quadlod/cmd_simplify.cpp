@@ -113,6 +113,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.progress = !global.quiet;
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);
+            // The output may live elsewhere: keep its `mtllib` lines pointing at the input's MTL.
+            for (const std::string& w : rebase_material_libraries(r.mesh, opt->input, opt->output))
+              std::fprintf(stderr, "warning: %s\n", w.c_str());
             clock = Stopwatch();
             const WriteResult written = write_mesh(r.mesh, opt->output);
             if (!written.ok()) return fail(written.error);

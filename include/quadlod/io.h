@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace quadlod {
 
@@ -96,6 +97,17 @@ WriteResult write_ply(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options = {});
 WriteResult write_off(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options = {});
+
+/// OBJ `mtllib` paths are resolved from the directory of the OBJ file that names them. When a
+/// mesh read from `input` is written to `output` in another directory, every relative library
+/// path that names an existing file next to `input` is rewritten to resolve from the directory
+/// of `output` (a relative path; absolute when no relative one exists). The MTL file itself is
+/// not copied: it names its textures relative to itself, so a copy elsewhere would lose them.
+/// Absolute paths stay as they are; a library that does not exist next to `input` is left
+/// unchanged and reported in the returned warnings (one line each). An `mtllib` line naming
+/// several files is rewritten file by file. Nothing changes when both files share a directory.
+std::vector<std::string> rebase_material_libraries(PolyMesh& mesh, const std::filesystem::path& input,
+                                                   const std::filesystem::path& output);
 
 /// Writes `contents` to `path` atomically (temp file in the same directory + rename).
 /// Shared by the mesh writers and by every JSON/CSV report the tool writes.

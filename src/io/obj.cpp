@@ -545,6 +545,50 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
 
 }  // namespace io_detail
 
+std::vector<std::string> rebase_material_libraries(PolyMesh& mesh, const std::filesystem::path& input,
+                                                   const std::filesystem::path& output) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> warnings;
+  std::error_code ec;
+  const fs::path from = fs::weakly_canonical(fs::absolute(input, ec).parent_path(), ec);
+  const fs::path to = fs::weakly_canonical(fs::absolute(output, ec).parent_path(), ec);
+  if (ec || from == to) return warnings;
+  // One library: relative to `to` when it exists next to the input, else unchanged.
+  auto rebase = [&](const std::string& lib) -> std::string {
+    const fs::path p(lib);
+    if (p.is_absolute()) return lib;
+    std::error_code e;
+    const fs::path target = fs::weakly_canonical(from / p, e);
+    if (e || !fs::is_regular_file(target, e)) {
+      warnings.push_back("material library '" + lib + "' not found next to " + input.string() +
+                         "; the output's mtllib line keeps it unchanged");
+      return lib;
+    }
+    const fs::path rel = target.lexically_relative(to);
+    return (rel.empty() ? target : rel).generic_string();
+  };
+  for (std::string& line : mesh.material_libraries) {
+    std::error_code e;
+    // The whole argument first (a file name with spaces), then its space-separated names.
+    if (fs::is_regular_file(from / fs::path(line), e) || line.find_first_of(" \t") == std::string::npos) {
+      line = rebase(line);
+      continue;
+    }
+    std::string rebuilt;
+    std::size_t i = 0;
+    while (i < line.size()) {
+      const std::size_t b = line.find_first_not_of(" \t", i);
+      if (b == std::string::npos) break;
+      const std::size_t e2 = std::min(line.find_first_of(" \t", b), line.size());
+      if (!rebuilt.empty()) rebuilt += ' ';
+      rebuilt += rebase(line.substr(b, e2 - b));
+      i = e2;
+    }
+    line = rebuilt;
+  }
+  return warnings;
+}
+
 WriteResult write_obj(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options) {
   WriteResult r = format_and_write(mesh, path, options, format_obj);
