@@ -16,8 +16,10 @@ it can) or `unsubdiv` (un-subdivide mode). TARGET is the wanted triangle-equival
 
 The OBJ is imported with the C++ importer (bpy.ops.wm.obj_import, Blender 3.2+) with the identity
 axis mapping (forward Y, up Z), all mesh objects are joined, and the evaluated mesh is written by
-this script (positions and polygons only, in the input's coordinates) to a temporary file next to
-OUTPUT, then renamed. One line `QUADLOD_PEER {json}` on stdout reports the mode, the parameter
+this script (positions, polygons, the active UV layer as `vt` and material slots as `usemtl`, in
+the input's coordinates; issue 7's UV comparison, bench/uv_compare, measures the UVs) to a
+temporary file next to OUTPUT, then renamed. UVs are written one `vt` per distinct value, so
+seams (different values at one vertex) survive and nothing else is split. One line `QUADLOD_PEER {json}` on stdout reports the mode, the parameter
 chosen, every try, the achieved count and the seconds of the modifier evaluations. Any failure
 prints `QUADLOD_PEER_ERROR message` and exits with status 2.
 """
@@ -116,7 +118,7 @@ def main(argv):
         parameter = {"iterations": best["iterations"]}
     seconds_search = time.perf_counter() - t1
 
-    # The final mesh, then written by hand: positions and polygons only.
+    # The final mesh, then written by hand: positions, polygons, UVs (active layer), materials.
     t2 = time.perf_counter()
     depsgraph.update()
     ev = obj.evaluated_get(depsgraph)
@@ -137,8 +139,27 @@ def main(argv):
             for v in mesh.vertices:
                 co = v.co if identity else mw @ v.co
                 out.write("v %.9g %.9g %.9g\n" % (co.x, co.y, co.z))
+            uv_layer = mesh.uv_layers.active
+            loop_vt = []
+            if uv_layer is not None:
+                vt_of = {}
+                for d in uv_layer.data:
+                    key = (d.uv[0], d.uv[1])
+                    if key not in vt_of:
+                        vt_of[key] = len(vt_of) + 1
+                        out.write("vt %.9g %.9g\n" % key)
+                    loop_vt.append(vt_of[key])
+            names = [slot.material.name if slot.material else "" for slot in obj.material_slots]
+            current = None
             for p in mesh.polygons:
-                out.write("f " + " ".join(str(i + 1) for i in p.vertices) + "\n")
+                if names and p.material_index < len(names) and names[p.material_index] != current:
+                    current = names[p.material_index]
+                    out.write("usemtl %s\n" % current)
+                if loop_vt:
+                    out.write("f " + " ".join("%d/%d" % (mesh.loops[li].vertex_index + 1, loop_vt[li])
+                                              for li in p.loop_indices) + "\n")
+                else:
+                    out.write("f " + " ".join(str(i + 1) for i in p.vertices) + "\n")
         os.replace(tmp, dst)
     except BaseException:
         if os.path.exists(tmp):
