@@ -391,6 +391,13 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (n < n0 && n > 0.0)
     planned = std::clamp(static_cast<int>(std::ceil(std::log(n / n0) / std::log(options.pass_ratio) - 1e-9)), 1, max_passes);
   const double pass_time = options.time_limit_seconds / planned;
+  // Every pass measures feature_tolerance against the original input's strict lines.
+  std::optional<FeatureReference> reference;
+  if (options.features) {
+    const Connectivity conn = build_connectivity(input);
+    reference = make_feature_reference(input, conn, find_feature_edges(input, conn, cp.features));
+    cp.feature_reference = &*reference;
+  }
   PolyMesh current;
   const PolyMesh* pass_input = &input;
   PassOutcome last;

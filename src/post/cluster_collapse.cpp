@@ -132,6 +132,8 @@ class Collapser {
   std::vector<std::int8_t> input_nm_;  // input vertex non-manifold: 1 / 0, −1 not computed yet
   bool features_on_ = false;
   FeatureEdges feat_;
+  FeatureReference own_reference_;
+  const FeatureReference* reference_ = nullptr;
 
   // Clusters. Every vertex has a root (the smallest member id of its cluster); a root's members
   // are member_list_[seg_begin_[r], seg_end_[r]), sorted ascending.
@@ -210,7 +212,14 @@ void Collapser::precompute() {
   }
   input_nm_.assign(nv_, -1);
   features_on_ = params_.respect_features;
-  if (features_on_) feat_ = find_feature_edges(mesh_, conn_, params_.features);
+  if (features_on_) {
+    feat_ = find_feature_edges(mesh_, conn_, params_.features);
+    reference_ = params_.feature_reference;
+    if (!reference_) {
+      own_reference_ = make_feature_reference(mesh_, conn_, feat_);
+      reference_ = &own_reference_;
+    }
+  }
   build_vertex_terms();
 }
 
@@ -944,43 +953,35 @@ void Collapser::check_vertex(Index v) {
 
 // Output edges that continue a strict feature line must stay on it: every output edge v–w that
 // comes from an input strict feature edge between the two clusters is sampled at ¼, ½, ¾, and each
-// sample must lie within feature_tolerance · |v w| of the strict feature edges around the two
-// clusters (the input polyline the output edge replaces). This is the rule `quadlod eval` counts
-// as `seams_torn` (docs/metrics.md §6c); a chord that cuts a curved seam or boundary too short
-// is refused here instead. Uses nbr_ of check_vertex.
+// sample must lie within feature_tolerance · |v w| of the reference lines of the same kind (the
+// original input's, in every pass of a multi-pass reduction). This is the rule `quadlod eval`
+// counts as `seams_torn` (docs/metrics.md §6c): a chord that cuts a curved seam or boundary too
+// short is refused here instead. Uses nbr_ of check_vertex.
 void Collapser::check_feature_edges(Index v) {
   bool strict_member = false;
   for (Index m : members(v)) strict_member = strict_member || feat_.on_strict(m);
   if (!strict_member) return;
   const double tol = std::max(0.0, params_.feature_tolerance);
+  constexpr std::uint8_t kKinds[4] = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam, kFeatureMaterialBorder};
   for (std::size_t i = 0; i < nbr_.size(); ++i) {
     const Index w = nbr_[i].first;
     if (i > 0 && nbr_[i - 1].first == w) continue;
-    // Input strict feature edges between the clusters, and the strict segments around both.
-    bool continues_line = false;
-    edges_tmp_.clear();
-    for (Index r : {v, w})
-      for (Index m : members(r))
-        for (Index c : conn_.corners_at_vertex(m))
-          for (Index ec : {c, conn_.corner_prev[c]}) {
-            const Index e = conn_.corner_edge[ec];
-            if (!feat_.is_strict(e)) continue;
-            edges_tmp_.push_back(e);
-            const Index o = root_[conn_.other_vertex(e, m)];
-            continues_line = continues_line || (r == v && o == w);
-          }
-    if (!continues_line) continue;
+    // Kinds of the input strict edges between the two clusters: the lines this edge continues.
+    std::uint8_t kinds = 0;
+    for (Index m : members(v))
+      for (Index c : conn_.corners_at_vertex(m))
+        for (Index ec : {c, conn_.corner_prev[c]}) {
+          const Index e = conn_.corner_edge[ec];
+          if (feat_.is_strict(e) && root_[conn_.other_vertex(e, m)] == w) kinds |= feat_.edge_bits[e];
+        }
+    if (!kinds) continue;
     const Vec3 &a = pos_[v], &b = pos_[w];
-    const double len = (b - a).norm();
+    const double bound = tol * (b - a).norm() + 1e-12 * diag_;
     bool ok = true;
-    for (double t : {0.25, 0.5, 0.75}) {
-      const Vec3 p = a + t * (b - a);
-      double best = INFINITY;
-      for (Index e : edges_tmp_) {
-        const auto [x, y] = conn_.edge_vertices[e];
-        best = std::min(best, (closest_point_on_segment(p, mesh_.positions[x], mesh_.positions[y]) - p).norm());
-      }
-      ok = ok && best <= tol * len + 1e-12 * diag_;
+    for (int k = 0; k < 4 && ok; ++k) {
+      if (!(kinds & kKinds[k]) || reference_->by_kind[k].size() == 0) continue;
+      for (double t : {0.25, 0.5, 0.75})
+        ok = ok && reference_->by_kind[k].nearest(a + t * (b - a)).distance_sq <= bound * bound;
     }
     if (!ok) {
       blame(v, CollapseRefusal::Feature);
@@ -1379,6 +1380,20 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
 }
 
 }  // namespace
+
+FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat) {
+  constexpr std::uint8_t kKinds[4] = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam, kFeatureMaterialBorder};
+  FeatureReference ref;
+  std::vector<std::array<Vec3, 2>> segments;
+  for (int k = 0; k < 4; ++k) {
+    segments.clear();
+    for (Index e = 0; e < conn.num_edges; ++e)
+      if (feat.is_strict(e) && (feat.edge_bits[e] & kKinds[k]))
+        segments.push_back({mesh.positions[conn.edge_vertices[e][0]], mesh.positions[conn.edge_vertices[e][1]]});
+    if (!segments.empty()) ref.by_kind[k] = SegmentBvh(segments);
+  }
+  return ref;
+}
 
 const char* to_string(CollapseRefusal reason) {
   switch (reason) {

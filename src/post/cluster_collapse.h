@@ -34,6 +34,7 @@
 // refused clusters.
 #pragma once
 
+#include "geometry/bvh.h"
 #include "mesh/connectivity.h"
 #include "mesh/features.h"
 #include "quadlod/mesh.h"
@@ -46,6 +47,15 @@
 #include <vector>
 
 namespace quadlod {
+
+/// The strict feature lines of the original input, one segment set per kind: boundary,
+/// non-manifold, UV seam, material border. A multi-pass reduction measures feature_tolerance
+/// against these in every pass, so the deviations of successive passes do not add up.
+struct FeatureReference {
+  std::array<SegmentBvh, 4> by_kind;
+};
+/// The strict edges of `mesh` (features from find_feature_edges on `conn`), sorted by kind.
+FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat);
 
 struct ClusterCollapseParams {
   // --- placement: the cluster quadric ---------------------------------------------------------
@@ -116,6 +126,9 @@ struct ClusterCollapseParams {
   /// tolerance `quadlod eval` uses for `seams_torn` (docs/metrics.md §6c). 0.2 forgives a chord
   /// over a turn of up to 43.6°, just under FeatureParams::corner_angle_deg.
   double feature_tolerance = 0.2;
+  /// Lines feature_tolerance is measured against (borrowed; must outlive the call). nullptr: the
+  /// strict lines of the mesh being collapsed.
+  const FeatureReference* feature_reference = nullptr;
 
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
