@@ -34,6 +34,7 @@
 #include <numeric>
 #include <optional>
 #include <queue>
+#include <random>
 
 namespace quadlod {
 
@@ -832,8 +833,169 @@ struct FlipSearchStats {
   Index passes = 0;
   Index flips = 0;
   Index swaps = 0;
+  Index exchanges = 0;
+  Index chains = 0;
   bool converged = false;
 };
+
+// Chain moves: flip a run of groups linked by λ_tri split pairs (consecutive segments of one
+// poly-chord, cut by breakpoints §3.2.2) as one move. Flipping one segment of a chord whose
+// neighbours stay splits two quad side pairs (+2 λ_tri), so single flips cannot walk a chord
+// segment by segment even where collapsing the whole run pays. From each seed the run grows
+// breadth-first over split partners that have the seed's value, flipping each (exact incremental
+// deltas; a collapse only where Eq. 8 allows it), up to `max_chain` groups; the prefix with the
+// best Eq. 9 change that lies in Eq. 2's band is kept if it lowers Eq. 9, the rest is undone.
+//
+//     seg 1     seg 2     seg 3          collapsing seg 2 alone splits the quads at both
+//   ┌──┬──┐  ┌──┬──┐  ┌──┬──┐          breakpoints (2 λ_tri); seg 1–3 together split none
+//   └──┴──┘  └──┴──┘  └──┴──┘
+bool chain_moves(SelectionState& st, const Groups& g, const GroupConstraints& gc, std::uint64_t target,
+                 const SelectionParams& params, const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
+  constexpr std::size_t max_chain = 64;
+  const double n = double(target), band = params.epsilon_n * n, eps = 1e-9;
+  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
+  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  std::vector<Index> stamp(g.count, kInvalidIndex), queue;
+  std::vector<std::pair<Index, std::int64_t>> flipped;  // group, Δcount when flipped
+  bool applied = false;
+  for (Index seed = 0; seed < g.count && clock.seconds() < seconds; ++seed) {
+    if (g.fixed[seed]) continue;
+    const std::uint8_t v = st.y[seed];
+    // Only seeds with a partner of the same value: otherwise this is a single flip.
+    if (std::none_of(gc.group_split[seed].begin(), gc.group_split[seed].end(),
+                     [&](Index b) { return !g.fixed[b] && st.y[b] == v; }))
+      continue;
+    const std::int64_t c0 = st.count;
+    const double ct0 = count_term(c0);
+    double rest = 0.0, best_gain = -eps;
+    std::size_t best_len = 0;
+    flipped.clear();
+    queue.assign(1, seed);
+    stamp[seed] = seed;
+    for (std::size_t head = 0; head < queue.size() && flipped.size() < max_chain; ++head) {
+      const Index a = queue[head];
+      if (st.y[a] != v || (v && !st.may_collapse(a))) continue;
+      const std::int64_t dc = st.delta_count(a);
+      rest += st.delta_rest(a, params);
+      st.flip(a, dc);
+      flipped.emplace_back(a, dc);
+      const double gain = count_term(st.count) - ct0 + rest;
+      if (in_band(st.count) && gain < best_gain) {
+        best_gain = gain;
+        best_len = flipped.size();
+      }
+      for (Index b : gc.group_split[a])
+        if (!g.fixed[b] && stamp[b] != seed && st.y[b] == v) {
+          stamp[b] = seed;
+          queue.push_back(b);
+        }
+    }
+    while (flipped.size() > best_len) {  // undo beyond the best prefix, last flip first
+      st.flip(flipped.back().first, -flipped.back().second);
+      flipped.pop_back();
+    }
+    if (best_len > 0) {
+      ++stats.chains;
+      applied = true;
+    }
+  }
+  return applied;
+}
+
+// Pair exchanges: keep one collapsed group and collapse one kept group *anywhere* on the mesh,
+// as one move. The count term alone blocks most single flips near N (each costs |ΔN'|), and
+// adjacent swaps only see neighbours; an exchange pairs, e.g., keeping a group whose collapse
+// emptied an Eq. 6 cluster (−λ_geo) with collapsing a cheap group of about the same ΔN' elsewhere.
+// Candidates come from a table of the best single moves per ΔN' value (the two flips' deltas add
+// up when the groups share no face or cluster); every candidate is re-evaluated exactly before it
+// is applied (the second flip's delta is computed after the first), so a move is taken only if it
+// lowers Eq. 9 and keeps Eq. 2's band and Eq. 8. Returns whether something was applied.
+bool pair_exchanges(SelectionState& st, const Groups& g, std::uint64_t target, const SelectionParams& params,
+                    const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
+  const double n = double(target), band = params.epsilon_n * n, eps = 1e-9;
+  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
+  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  struct Move {
+    std::int64_t dc;
+    double dr;
+    Index grp;
+  };
+  // Single moves, sorted by ΔN' and then by their other cost; the best `per_bucket` of each ΔN'.
+  constexpr std::size_t per_bucket = 3;
+  std::vector<Move> collapse, keep;
+  for (Index grp = 0; grp < g.count; ++grp) {
+    if (g.fixed[grp]) continue;
+    if (st.y[grp]) {
+      if (!st.may_collapse(grp)) continue;
+      const std::int64_t dc = st.delta_count(grp);
+      if (dc < 0) collapse.push_back({dc, st.delta_rest(grp, params), grp});
+    } else {
+      const std::int64_t dc = st.delta_count(grp);
+      if (dc > 0) keep.push_back({dc, st.delta_rest(grp, params), grp});
+    }
+  }
+  auto buckets = [&](std::vector<Move>& moves) {
+    std::sort(moves.begin(), moves.end(), [](const Move& l, const Move& r) {
+      return l.dc != r.dc ? l.dc < r.dc : (l.dr != r.dr ? l.dr < r.dr : l.grp < r.grp);
+    });
+    std::vector<std::size_t> starts;  // first index of each ΔN' value
+    for (std::size_t i = 0; i < moves.size(); ++i)
+      if (i == 0 || moves[i].dc != moves[i - 1].dc) starts.push_back(i);
+    starts.push_back(moves.size());
+    return starts;
+  };
+  const std::vector<std::size_t> cs = buckets(collapse), ks = buckets(keep);
+  struct Candidate {
+    double gain;
+    Index a, b;  // collapse a, keep b
+  };
+  std::vector<Candidate> candidates;
+  const std::int64_t c0 = st.count;
+  for (std::size_t i = 0; i + 1 < cs.size(); ++i) {
+    const Move& a = collapse[cs[i]];
+    for (std::size_t j = 0; j + 1 < ks.size(); ++j) {
+      const Move& b = keep[ks[j]];
+      const std::int64_t c = c0 + a.dc + b.dc;
+      if (!in_band(c)) continue;
+      const double base = count_term(c) - count_term(c0);
+      if (base + a.dr + b.dr >= -eps) continue;
+      for (std::size_t x = cs[i]; x < std::min(cs[i + 1], cs[i] + per_bucket); ++x)
+        for (std::size_t z = ks[j]; z < std::min(ks[j + 1], ks[j] + per_bucket); ++z) {
+          const double gain = base + collapse[x].dr + keep[z].dr;
+          if (gain < -eps) candidates.push_back({gain, collapse[x].grp, keep[z].grp});
+        }
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& l, const Candidate& r) {
+    return l.gain != r.gain ? l.gain < r.gain : (l.a != r.a ? l.a < r.a : l.b < r.b);
+  });
+  std::vector<std::uint8_t> used(g.count, 0);
+  bool applied = false;
+  for (const Candidate& cand : candidates) {
+    if (clock.seconds() >= seconds) break;
+    if (used[cand.a] || used[cand.b] || !st.y[cand.a] || st.y[cand.b]) continue;
+    const std::int64_t before = st.count;
+    const double rb = st.delta_rest(cand.b, params);
+    const std::int64_t db = st.delta_count(cand.b);
+    st.flip(cand.b, db);
+    bool take = st.may_collapse(cand.a);
+    std::int64_t da = 0;
+    if (take) {
+      da = st.delta_count(cand.a);
+      take = in_band(st.count + da) &&
+             count_term(st.count + da) - count_term(before) + rb + st.delta_rest(cand.a, params) < -eps;
+    }
+    if (take) {
+      st.flip(cand.a, da);
+      used[cand.a] = used[cand.b] = 1;
+      ++stats.exchanges;
+      applied = true;
+    } else {
+      st.flip(cand.b, -db);  // undo
+    }
+  }
+  return applied;
+}
 
 std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
                                       std::vector<std::uint8_t> y, std::uint64_t target,
@@ -891,6 +1053,10 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
         st.flip(b, -db);  // undo
       }
     }
+    if (params.chain_moves && clock.seconds() < seconds)
+      improved |= chain_moves(st, g, gc, target, params, clock, seconds, stats);
+    if (params.pair_exchanges && !improved && clock.seconds() < seconds)
+      improved = pair_exchanges(st, g, target, params, clock, seconds, stats);
   }
   stats.converged = !improved;
   return std::move(st.y);
@@ -913,6 +1079,43 @@ void group_adjacency(const Groups& g, const FaceGroups& fg, std::vector<Index>& 
     adjacent.insert(adjacent.end(), l.begin(), l.end());
     offsets[grp + 1] = static_cast<Index>(adjacent.size());
   }
+}
+
+// Neighbourhoods of one sweep of the large-neighbourhood search: a partition of the free groups
+// into regions of `size` groups (the last one smaller). A region grows breadth-first over groups
+// that share a face from the first seed in `order` that no region took yet, only over untaken
+// groups; when that runs out (a small part of the mesh, or enclosed by earlier regions) it goes
+// on from the next untaken seed, so a region may hold several patches — the count row couples
+// them anyway. Fixed groups are crossed but never freed. Each region lists its free groups.
+std::vector<std::vector<Index>> neighbourhood_partition(const Groups& g, const std::vector<Index>& adj_offsets,
+                                                        const std::vector<Index>& adjacent,
+                                                        const std::vector<Index>& order, Index size) {
+  std::vector<std::vector<Index>> regions;
+  std::vector<std::uint8_t> seen(g.count, 0);  // queued by some region
+  std::vector<Index> queue, region;
+  for (Index seed : order) {
+    if (g.fixed[seed] || seen[seed]) continue;
+    queue.assign(1, seed);
+    seen[seed] = 1;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const Index a = queue[head];
+      if (!g.fixed[a]) {
+        region.push_back(a);
+        if (region.size() >= size) {  // full: groups still queued go back to the pool
+          for (std::size_t k = head + 1; k < queue.size(); ++k) seen[queue[k]] = 0;
+          break;
+        }
+      }
+      for (Index k = adj_offsets[a]; k < adj_offsets[a + 1]; ++k)
+        if (!seen[adjacent[k]]) {
+          seen[adjacent[k]] = 1;
+          queue.push_back(adjacent[k]);
+        }
+    }
+    if (region.size() >= size) regions.push_back(std::move(region)), region.clear();
+  }
+  if (!region.empty()) regions.push_back(std::move(region));
+  return regions;
 }
 
 }  // namespace
@@ -988,44 +1191,40 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   auto neighbourhood_search = [&](std::vector<std::uint8_t> y, double seconds) {
     Stopwatch lns_clock;
     double best = group_objective(groups, gc, fg, y, target, params);
-    std::vector<std::uint8_t> free(groups.count, 0), covered(groups.count, 0);
-    std::vector<Index> stamp(groups.count, kInvalidIndex), queue, freed;
-    Index cursor = 0, improved_in_sweep = 0;
+    std::vector<std::uint8_t> free(groups.count, 0);
+    Index improved_in_sweep = 0, idle_sweeps = 0;
     ilp::SolveResult summary;
     summary.backend = params.solver;
     summary.call = ilp::CallStatus::Ok;
     auto solver = ilp::make_solver(params.solver, &summary.message);
     if (!solver) return y;
+    // Sweep k solves the regions of one partition of the groups (neighbourhood_partition): seeds
+    // in index order for the first sweep, in a shuffled order (seeded by k) after that, so the
+    // region borders of one sweep lie inside regions of the next. Two sweeps in a row without an
+    // improvement end the search.
+    std::vector<Index> order(groups.count);
+    std::iota(order.begin(), order.end(), Index{0});
+    std::vector<std::vector<Index>> regions;
+    std::size_t next_region = 0;
+    std::mt19937 rng(params.solve.seed);
     while (lns_clock.seconds() < seconds) {
-      // Next seed: the first group of this sweep not yet inside a neighbourhood.
-      while (cursor < groups.count && (covered[cursor] || groups.fixed[cursor])) ++cursor;
-      if (cursor == groups.count) {
-        ++result.neighbourhood_sweeps;
-        if (improved_in_sweep == 0) {
-          result.neighbourhoods_converged = true;
-          break;
-        }
-        improved_in_sweep = 0;
-        std::fill(covered.begin(), covered.end(), 0);
-        cursor = 0;
-        continue;
-      }
-      const Index round = result.neighbourhoods;
-      queue.assign(1, cursor);
-      stamp[cursor] = round;
-      freed.clear();
-      for (std::size_t head = 0; head < queue.size() && freed.size() < params.neighbourhood_groups; ++head) {
-        const Index a = queue[head];
-        if (!groups.fixed[a]) {
-          free[a] = covered[a] = 1;
-          freed.push_back(a);
-        }
-        for (Index k = adj_offsets[a]; k < adj_offsets[a + 1]; ++k)
-          if (stamp[adjacent[k]] != round) {
-            stamp[adjacent[k]] = round;
-            queue.push_back(adjacent[k]);
+      if (next_region == regions.size()) {
+        if (!regions.empty()) {
+          ++result.neighbourhood_sweeps;
+          idle_sweeps = improved_in_sweep == 0 ? idle_sweeps + 1 : 0;
+          if (idle_sweeps >= 2 || (idle_sweeps == 1 && regions.size() == 1)) {
+            result.neighbourhoods_converged = true;
+            break;
           }
+          improved_in_sweep = 0;
+          std::shuffle(order.begin(), order.end(), rng);
+        }
+        regions = neighbourhood_partition(groups, adj_offsets, adjacent, order, params.neighbourhood_groups);
+        next_region = 0;
+        if (regions.empty()) break;
       }
+      const std::vector<Index>& freed = regions[next_region++];
+      for (Index a : freed) free[a] = 1;
       Stopwatch build_clock;
       ModelBuilder sub(mesh, conn, analysis, groups, gc, fg, importance, params);
       sub.set_scope(free, y);
@@ -1083,6 +1282,8 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.flip_passes = fs.passes;
     result.flips = fs.flips;
     result.swaps = fs.swaps;
+    result.exchanges = fs.exchanges;
+    result.chains = fs.chains;
     result.seconds_flip_search = flip_clock.seconds();
   }
 

@@ -101,6 +101,12 @@ struct SelectionParams {
   /// Budget of the flip/swap local search that polishes the greedy start, as a fraction of the
   /// time limit (it usually converges in far less).
   double flip_search_time_fraction = 0.3;
+  /// Pair exchanges in the local search: keep one collapsed group and collapse one kept group
+  /// anywhere on the mesh as one move (docs/formulation.md, "Speed").
+  bool pair_exchanges = true;
+  /// Chain moves in the local search: runs of consecutive segments of a poly-chord (groups
+  /// linked by λ_tri split pairs) flipped as one move (docs/formulation.md, "Speed").
+  bool chain_moves = true;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
@@ -150,7 +156,7 @@ struct SelectionResult {
   bool neighbourhoods_converged = false;  ///< a full sweep improved nothing
   double seconds_neighbourhood_build = 0.0;  ///< building the neighbourhood models
   double flip_search_objective = 0.0;   ///< Eq. 9 after the flip/swap local search
-  Index flip_passes = 0, flips = 0, swaps = 0;
+  Index flip_passes = 0, flips = 0, swaps = 0, exchanges = 0, chains = 0;
   double seconds_flip_search = 0.0;
   SelectionModelStats model;
   double seconds_build = 0.0;

@@ -28,11 +28,14 @@ std::string num(double v) {
 
 [[noreturn]] void fail(const std::string& what) { throw std::invalid_argument("ilp::Model: " + what); }
 
-void check_bounds(double lower, double upper, const std::string& what) {
-  if (std::isnan(lower) || std::isnan(upper)) fail(what + ": NaN bound");
+// `what()` names the column or row; it is only called on failure (building the text for every
+// column and row cost more than the rest of add_var / add_range on neighbourhood models).
+template <class What>
+void check_bounds(double lower, double upper, const What& what) {
+  if (std::isnan(lower) || std::isnan(upper)) fail(what() + ": NaN bound");
   if (lower == kInf || upper == -kInf)
-    fail(what + ": bounds [" + num(lower) + ", " + num(upper) + "] admit no finite value");
-  if (lower > upper) fail(what + ": lower bound " + num(lower) + " > upper bound " + num(upper));
+    fail(what() + ": bounds [" + num(lower) + ", " + num(upper) + "] admit no finite value");
+  if (lower > upper) fail(what() + ": lower bound " + num(lower) + " > upper bound " + num(upper));
 }
 
 }  // namespace
@@ -82,11 +85,11 @@ Col Model::add_var(VarType type, double lower, double upper, double objective,
   const Col c = num_cols();
   // Backends index columns with int (COIN's CoinBigIndex is 32-bit signed).
   if (c >= static_cast<Col>(INT32_MAX)) fail("too many columns");
-  const std::string what = "column " + std::to_string(c) + (name.empty() ? "" : " '" + std::string(name) + "'");
+  auto what = [&] { return "column " + std::to_string(c) + (name.empty() ? "" : " '" + std::string(name) + "'"); };
   check_bounds(lower, upper, what);
   if (type == VarType::Binary && (lower < 0.0 || upper > 1.0))
-    fail(what + ": binary bounds [" + num(lower) + ", " + num(upper) + "] outside [0, 1]");
-  if (!std::isfinite(objective)) fail(what + ": objective coefficient " + num(objective));
+    fail(what() + ": binary bounds [" + num(lower) + ", " + num(upper) + "] outside [0, 1]");
+  if (!std::isfinite(objective)) fail(what() + ": objective coefficient " + num(objective));
   col_type_.push_back(type);
   col_lower_.push_back(lower);
   col_upper_.push_back(upper);
@@ -105,9 +108,9 @@ Row Model::add_range(double lower, std::span<const Term> terms, double upper,
   auto what = [&] {
     return "row " + std::to_string(r) + (name.empty() ? "" : " '" + std::string(name) + "'");
   };
-  check_bounds(lower, upper, what());
+  check_bounds(lower, upper, what);
   for (const Term& t : terms) {
-    check_col(t.col, what().c_str());
+    if (t.col >= num_cols()) check_col(t.col, what().c_str());
     if (!std::isfinite(t.coef)) fail(what() + ": coefficient " + num(t.coef) + " of column " + std::to_string(t.col));
   }
 
@@ -153,10 +156,10 @@ void Model::set_objective_offset(double offset) {
 
 void Model::set_bounds(Col col, double lower, double upper) {
   check_col(col, "set_bounds");
-  const std::string what = "set_bounds of column " + std::to_string(col);
+  auto what = [&] { return "set_bounds of column " + std::to_string(col); };
   check_bounds(lower, upper, what);
   if (col_type_[col] == VarType::Binary && (lower < 0.0 || upper > 1.0))
-    fail(what + ": binary bounds [" + num(lower) + ", " + num(upper) + "] outside [0, 1]");
+    fail(what() + ": binary bounds [" + num(lower) + ", " + num(upper) + "] outside [0, 1]");
   col_lower_[col] = lower;
   col_upper_[col] = upper;
 }

@@ -100,6 +100,8 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"flip_passes", s.flip_passes},
       {"flips", s.flips},
       {"swaps", s.swaps},
+      {"exchanges", s.exchanges},
+      {"chains", s.chains},
       {"seconds_flip_search", s.seconds_flip_search},
       {"seconds_build", s.seconds_build},
       {"seconds_greedy", s.seconds_greedy},
