@@ -29,6 +29,7 @@
 #include "util/progress.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -375,6 +376,57 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
 }
 
 // ------------------------------------------------------------------------------------------
+// Where each group appears, so that a neighbourhood model touches only what its free groups touch
+// instead of scanning every face and cluster (ModelBuilder::set_scope with an index).
+struct ScopeIndex {
+  std::vector<Index> face_offsets, faces;    // group → faces with an edge in it
+  std::vector<Index> split_offsets, splits;  // group → ids into GroupConstraints::split_pairs
+  std::vector<Index> tri_offsets, tri_pairs; // Eq. 7 cluster → ids into tri_neighbours (either end)
+};
+
+// CSR from (key, value) pairs, keys < n.
+void make_csr(Index n, const std::vector<std::pair<Index, Index>>& pairs, std::vector<Index>& offsets,
+              std::vector<Index>& values) {
+  offsets.assign(std::size_t{n} + 1, 0);
+  for (const auto& kv : pairs) ++offsets[kv.first + 1];
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  values.resize(pairs.size());
+  std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+  for (const auto& [k, v] : pairs) values[fill[k]++] = v;
+}
+
+ScopeIndex make_scope_index(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg) {
+  ScopeIndex ix;
+  std::vector<std::pair<Index, Index>> pairs;
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f)
+    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i) pairs.emplace_back(fg.group[i], f);
+  make_csr(g.count, pairs, ix.face_offsets, ix.faces);
+  pairs.clear();
+  for (Index k = 0; k < gc.split_pairs.size(); ++k) {
+    pairs.emplace_back(gc.split_pairs[k].first, k);
+    pairs.emplace_back(gc.split_pairs[k].second, k);
+  }
+  make_csr(g.count, pairs, ix.split_offsets, ix.splits);
+  pairs.clear();
+  for (Index k = 0; k < gc.tri_neighbours.size(); ++k) {
+    pairs.emplace_back(gc.tri_neighbours[k].first, k);
+    if (gc.tri_neighbours[k].second != gc.tri_neighbours[k].first) pairs.emplace_back(gc.tri_neighbours[k].second, k);
+  }
+  make_csr(static_cast<Index>(gc.tri.size()), pairs, ix.tri_offsets, ix.tri_pairs);
+  return ix;
+}
+
+// Sorted distinct values of lists[key] over the keys.
+std::vector<Index> gather(const std::vector<Index>& keys, const std::vector<Index>& offsets,
+                          const std::vector<Index>& values) {
+  std::vector<Index> out;
+  for (Index k : keys) out.insert(out.end(), values.begin() + offsets[k], values.begin() + offsets[k + 1]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------
 // The model. Columns are created in a fixed order so that the greedy start can be completed
 // into a full solution vector by evaluating the same definitions.
 class ModelBuilder {
@@ -390,6 +442,17 @@ class ModelBuilder {
   void set_scope(const std::vector<std::uint8_t>& free, const std::vector<std::uint8_t>& base) {
     free_ = &free;
     base_ = &base;
+  }
+  /// The same through `index`: only the faces, clusters and pairs of the free groups (the sorted
+  /// `free_list`, i.e. free[g] = 1) are visited, and fixed groups get a column only where such a
+  /// row needs one. `base_count` = N' of `base`. Gives the model of the scan above up to the
+  /// fixed columns no row uses (tests/test_formulation.cpp checks this).
+  void set_scope(const std::vector<std::uint8_t>& free, const std::vector<std::uint8_t>& base,
+                 const ScopeIndex& index, const std::vector<Index>& free_list, std::uint64_t base_count) {
+    set_scope(free, base);
+    index_ = &index;
+    free_list_ = &free_list;
+    base_count_ = base_count;
   }
 
   void build(std::uint64_t target, bool band) {
@@ -412,7 +475,8 @@ class ModelBuilder {
     if (exact_) {
       for (Index e = 0; e < conn_.num_edges; ++e) x[edge_col_[e]] = y[g_.edge_group[e]];
     } else {
-      for (Index grp = 0; grp < g_.count; ++grp) x[group_col_[grp]] = y[grp];
+      for (Col c = 0; c < col_group_.size(); ++c)
+        if (col_group_[c] != kInvalidIndex) x[c] = y[col_group_[c]];
     }
     (void)value_of_col;
     for (const Aggregate& a : aggregates_) {
@@ -453,6 +517,11 @@ class ModelBuilder {
     for (Index grp = 0; grp < g_.count; ++grp) y[grp] = x[group_col_[grp]] > 0.5;
     return y;
   }
+  /// Writes the free groups' values of a neighbourhood solution into y.
+  void read_free_groups(const std::vector<double>& x, std::vector<std::uint8_t>& y) const {
+    for (Col c = 0; c < col_group_.size(); ++c)
+      if (col_group_[c] != kInvalidIndex && (*free_)[col_group_[c]]) y[col_group_[c]] = x[c] > 0.5;
+  }
 
   /// Group values back from a solution (rounded).
   std::vector<std::uint8_t> edge_bits(const std::vector<double>& x) const {
@@ -488,15 +557,27 @@ class ModelBuilder {
     std::vector<Col> cols;
   };
 
-  Col edge_col(Index e) const { return exact_ ? edge_col_[e] : group_col_[g_.edge_group[e]]; }
+  Col edge_col(Index e) { return exact_ ? edge_col_[e] : group_col(g_.edge_group[e]); }
+
+  // The column of a group; with an index scope, fixed groups get theirs when first used.
+  Col group_col(Index grp) {
+    if (group_col_[grp] == kNone) add_group_col(grp);
+    return group_col_[grp];
+  }
+  void add_group_col(Index grp) {
+    double lo = g_.fixed[grp] ? 1.0 : 0.0, hi = 1.0;
+    if (free_ && !(*free_)[grp]) lo = hi = (*base_)[grp];
+    group_col_[grp] = model.add_var(ilp::VarType::Binary, lo, hi, -params_.lambda_edge * g_.importance[grp]);
+    col_group_.resize(model.num_cols(), kInvalidIndex);
+    col_group_[group_col_[grp]] = grp;
+  }
 
   void build_fast_vars() {
-    group_col_.resize(g_.count);
-    for (Index grp = 0; grp < g_.count; ++grp) {
-      double lo = g_.fixed[grp] ? 1.0 : 0.0, hi = 1.0;
-      if (free_ && !(*free_)[grp]) lo = hi = (*base_)[grp];
-      group_col_[grp] = model.add_var(ilp::VarType::Binary, lo, hi,
-                                      -params_.lambda_edge * g_.importance[grp]);
+    group_col_.assign(g_.count, kNone);
+    if (index_) {
+      for (Index grp : *free_list_) add_group_col(grp);
+    } else {
+      for (Index grp = 0; grp < g_.count; ++grp) add_group_col(grp);
     }
     stats.edge_groups = g_.count;
     stats.fixed_kept_groups = static_cast<Index>(std::count(g_.fixed.begin(), g_.fixed.end(), 1));
@@ -517,7 +598,7 @@ class ModelBuilder {
   }
 
   // Terms Σ m x over the face's columns (merged per column).
-  std::vector<Term> face_terms(Index f) const {
+  std::vector<Term> face_terms(Index f) {
     std::vector<Term> terms;
     for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
       const Col col = edge_col(conn_.corner_edge[c]);
@@ -532,13 +613,27 @@ class ModelBuilder {
     std::vector<std::vector<Term>> owner_rest(model.num_cols());
     std::vector<double> owner_constant(model.num_cols(), 0.0), owner_upper(model.num_cols(), 0.0);
     std::vector<Index> owned(model.num_cols(), 0);
-    for (Index f = 0; f < mesh_.num_faces(); ++f) {
-      if (free_ && !face_touches_free(f)) {
+    std::vector<Index> scoped;  // with an index: the faces of the free groups
+    if (index_) {
+      scoped = gather(*free_list_, index_->face_offsets, index_->faces);
+      count_constant_ = double(base_count_);
+      for (Index f : scoped) count_constant_ -= double(face_count(fg_, f, *base_));
+    }
+    const Index face_end = index_ ? static_cast<Index>(scoped.size()) : mesh_.num_faces();
+    for (Index fi = 0; fi < face_end; ++fi) {
+      const Index f = index_ ? scoped[fi] : fi;
+      if (free_ && !index_ && !face_touches_free(f)) {
         count_constant_ += double(face_count(fg_, f, *base_));
         continue;
       }
       const double k = mesh_.face_size(f);
       std::vector<Term> terms = face_terms(f);
+      if (owned.size() < model.num_cols()) {  // fixed groups' columns made on the way
+        owner_rest.resize(model.num_cols());
+        owner_constant.resize(model.num_cols(), 0.0);
+        owner_upper.resize(model.num_cols(), 0.0);
+        owned.resize(model.num_cols(), 0);
+      }
       if (!exact_) {
         if (terms.size() == 1) {  // one group: t_f = (k − 2) y
           count_terms_.push_back({terms[0].col, k - 2.0});
@@ -580,8 +675,12 @@ class ModelBuilder {
       }
       add_general_face(terms, k);
     }
-    for (Col owner = 0; owner < owned.size(); ++owner) {
-      if (!owned[owner]) continue;
+    // Aggregates in group order (the column order of the scan), whatever order the columns got.
+    std::vector<Col> owners;
+    for (Col c = 0; c < owned.size(); ++c)
+      if (owned[c]) owners.push_back(c);
+    std::sort(owners.begin(), owners.end(), [&](Col l, Col r) { return col_group_[l] < col_group_[r]; });
+    for (Col owner : owners) {
       Aggregate a;
       a.owner = owner;
       a.constant = owner_constant[owner];
@@ -619,9 +718,8 @@ class ModelBuilder {
   }
 
   double group_size(Col col) const {
-    // Only called in fast mode, where columns of groups are the first g_.count columns.
-    const Index grp = static_cast<Index>(col);
-    return grp < g_.count ? double(g_.offsets[grp + 1] - g_.offsets[grp]) : 0.0;
+    const Index grp = col < col_group_.size() ? col_group_[col] : kInvalidIndex;
+    return grp != kInvalidIndex ? double(g_.offsets[grp + 1] - g_.offsets[grp]) : 0.0;
   }
 
   // The paper's per-face rows: Eq. 3 and t_f = x_f (S_f − 2) linearised.
@@ -676,8 +774,13 @@ class ModelBuilder {
         if (a != b && !(g_.fixed[a] && g_.fixed[b])) add_split(edge_col_[e], edge_col_[f]);
       });
     } else {
-      for (const auto& [a, b] : gc_.split_pairs)
-        if (!free_ || (*free_)[a] || (*free_)[b]) add_split(group_col_[a], group_col_[b]);
+      if (index_) {
+        for (Index k : gather(*free_list_, index_->split_offsets, index_->splits))
+          add_split(group_col(gc_.split_pairs[k].first), group_col(gc_.split_pairs[k].second));
+      } else {
+        for (const auto& [a, b] : gc_.split_pairs)
+          if (!free_ || (*free_)[a] || (*free_)[b]) add_split(group_col(a), group_col(b));
+      }
     }
     stats.split_pairs = static_cast<Index>(split_.size());
   }
@@ -702,7 +805,15 @@ class ModelBuilder {
     } else {
       // Only the binding side: with λ_geo > 0 a minimiser never raises x_C above what
       // x_C ≥ 1 − Σ y forces, so x_C ≤ 1 − y rows are redundant at every optimum.
-      for (const auto& groups : gc_.geo) {
+      std::vector<Index> scoped;
+      if (index_) {
+        for (Index grp : *free_list_) scoped.insert(scoped.end(), gc_.group_geo[grp].begin(), gc_.group_geo[grp].end());
+        std::sort(scoped.begin(), scoped.end());
+        scoped.erase(std::unique(scoped.begin(), scoped.end()), scoped.end());
+      }
+      const Index end = index_ ? static_cast<Index>(scoped.size()) : static_cast<Index>(gc_.geo.size());
+      for (Index ci = 0; ci < end; ++ci) {
+        const auto& groups = gc_.geo[index_ ? scoped[ci] : ci];
         if (free_) {
           // Outside the neighbourhood, or kept by a fixed group: a constant of the objective.
           bool any_free = false, kept = false;
@@ -716,8 +827,8 @@ class ModelBuilder {
         std::vector<Term> row{{xc, 1.0}};
         std::vector<Col> cols;
         for (Index grp : groups) {
-          row.push_back({group_col_[grp], 1.0});
-          cols.push_back(group_col_[grp]);
+          row.push_back({group_col(grp), 1.0});
+          cols.push_back(group_col(grp));
         }
         model.add_ge(row, 1.0);
         geo_.push_back({xc, std::move(cols)});
@@ -728,25 +839,32 @@ class ModelBuilder {
 
   // Eqs. 7–8: x_Ct = 1 iff some edge of C_t is collapsed; then every neighbour keeps all edges.
   void build_tri_clusters() {
-    const std::size_t nt = analysis_.triangles.clusters.size();
+    const auto nt = static_cast<Index>(analysis_.triangles.clusters.size());
+    const auto& neighbours = analysis_.triangles.neighbours;
     // In a neighbourhood only clusters with a free group and their Eq. 8 partners take part.
     std::vector<std::uint8_t> active(nt, 1), needed(nt, 1);
-    if (free_) {
-      for (std::size_t i = 0; i < nt; ++i) {
+    std::vector<Index> pairs;  // Eq. 8 pairs with an active end (index scope)
+    if (index_) {
+      std::fill(active.begin(), active.end(), 0);
+      std::fill(needed.begin(), needed.end(), 0);
+      std::vector<Index> act;
+      for (Index grp : *free_list_) act.insert(act.end(), gc_.group_tri[grp].begin(), gc_.group_tri[grp].end());
+      for (Index i : act) active[i] = needed[i] = 1;
+      pairs = gather(act, index_->tri_offsets, index_->tri_pairs);
+      for (Index k : pairs) needed[neighbours[k].first] = needed[neighbours[k].second] = 1;
+    } else if (free_) {
+      for (Index i = 0; i < nt; ++i) {
         active[i] = 0;
         for (Index grp : gc_.tri[i]) active[i] |= (*free_)[grp];
       }
       needed = active;
-      for (const auto& [i, j] : analysis_.triangles.neighbours)
+      for (const auto& [i, j] : neighbours)
         if (active[i] || active[j]) needed[i] = needed[j] = 1;
     }
-    std::vector<std::vector<Col>> cols_of(nt);
-    for (std::size_t i = 0; i < cols_of.size(); ++i) {
-      if (!needed[i]) {
-        tri_.push_back({kNone, {}});
-        continue;
-      }
-      auto& cols = cols_of[i];
+    std::vector<Index> slot(nt, kInvalidIndex);  // cluster → tri_ entry
+    for (Index i = 0; i < nt; ++i) {
+      if (!needed[i]) continue;
+      std::vector<Col> cols;
       for (Index e : analysis_.triangles.clusters[i].edges) cols.push_back(edge_col(e));
       std::sort(cols.begin(), cols.end());
       if (!exact_) cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
@@ -765,18 +883,23 @@ class ModelBuilder {
         var = model.add_continuous(0.0, 1.0);
         for (Col c : cols) model.add_ge({{var, 1.0}, {c, 1.0}}, 1.0);  // x_Ct ≥ 1 − y_g
       }
-      tri_.push_back({var, cols});
+      slot[i] = static_cast<Index>(tri_.size());
+      tri_.push_back({var, std::move(cols)});
     }
-    for (const auto& [i, j] : analysis_.triangles.neighbours) {
-      if (!active[i] && !active[j]) continue;
-      const auto& cj = cols_of[j];
-      std::vector<Term> row{{tri_[i].var, double(cj.size())}};
+    auto add_eq8 = [&](Index i, Index j) {
+      const auto& cj = tri_[slot[j]].cols;
+      std::vector<Term> row{{tri_[slot[i]].var, double(cj.size())}};
       for (Col c : cj) row.push_back({c, -1.0});
       model.add_le(row, 0.0);  // Eq. 8: |C_j| x_Ct(i) ≤ Σ_{e ∈ C_j} x_e
       ++stats.tri_neighbour_rows;
+    };
+    if (index_) {
+      for (Index k : pairs) add_eq8(neighbours[k].first, neighbours[k].second);
+    } else {
+      for (const auto& [i, j] : neighbours)
+        if (active[i] || active[j]) add_eq8(i, j);
     }
-    stats.tri_clusters = static_cast<Index>(
-        std::count_if(tri_.begin(), tri_.end(), [](const TriCluster& c) { return c.var != kNone; }));
+    stats.tri_clusters = static_cast<Index>(tri_.size());
   }
 
   const PolyMesh& mesh_;
@@ -790,6 +913,10 @@ class ModelBuilder {
   bool exact_ = false;
   const std::vector<std::uint8_t>* free_ = nullptr;
   const std::vector<std::uint8_t>* base_ = nullptr;
+  const ScopeIndex* index_ = nullptr;
+  const std::vector<Index>* free_list_ = nullptr;
+  std::uint64_t base_count_ = 0;
+  std::vector<Index> col_group_;  // column → group (kInvalidIndex for other columns)
   std::vector<Col> group_col_, edge_col_;
   std::vector<Term> count_terms_;
   double count_constant_ = 0.0;
@@ -1207,6 +1334,14 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     std::vector<std::vector<Index>> regions;
     std::size_t next_region = 0;
     std::mt19937 rng(params.solve.seed);
+    const ScopeIndex scope_index = make_scope_index(groups, gc, fg);
+    auto count_of = [&](const std::vector<std::uint8_t>& bits) {
+      std::uint64_t n = 0;
+      for (Index f = 0; f + 1 < fg.offsets.size(); ++f) n += face_count(fg, f, bits);
+      return n;
+    };
+    std::uint64_t count = count_of(y);
+    std::vector<Index> free_list;
     while (lns_clock.seconds() < seconds) {
       if (next_region == regions.size()) {
         if (!regions.empty()) {
@@ -1223,11 +1358,12 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
         next_region = 0;
         if (regions.empty()) break;
       }
-      const std::vector<Index>& freed = regions[next_region++];
-      for (Index a : freed) free[a] = 1;
+      free_list = regions[next_region++];
+      std::sort(free_list.begin(), free_list.end());
+      for (Index a : free_list) free[a] = 1;
       Stopwatch build_clock;
       ModelBuilder sub(mesh, conn, analysis, groups, gc, fg, importance, params);
-      sub.set_scope(free, y);
+      sub.set_scope(free, y, scope_index, free_list, count);
       sub.build(target, true);
       sub.model.set_initial_solution(sub.complete(y, target));
       result.seconds_neighbourhood_build += build_clock.seconds();
@@ -1242,12 +1378,17 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       ++result.neighbourhoods;
       summary.nodes += r.nodes;
       summary.iterations += r.iterations;
-      if (r.has_solution() && !r.solution_is_start && reduced.violated_constant_rows == 0) {
-        std::vector<std::uint8_t> candidate = sub.group_bits(reduced.expand(sub.model, r.solution));
-        const double value = group_objective(groups, gc, fg, candidate, target, params);
-        if (value < best - 1e-9 * std::max(1.0, std::abs(best))) {
-          best = value;
-          y = std::move(candidate);
+      // The neighbourhood model holds every term of Eq. 9 that its free groups change, so the
+      // change of its objective is the change of Eq. 9.
+      const double change = r.objective - reduced.model.evaluate(reduced.model.initial_solution());
+      if (r.has_solution() && !r.solution_is_start && reduced.violated_constant_rows == 0 &&
+          change < -1e-9 * std::max(1.0, std::abs(best))) {
+        {
+          sub.read_free_groups(reduced.expand(sub.model, r.solution), y);
+          best += change;
+          count = count_of(y);
+          assert(std::abs(best - group_objective(groups, gc, fg, y, target, params)) <=
+                 1e-6 * std::max(1.0, std::abs(best)));
           ++result.neighbourhoods_improved;
           ++improved_in_sweep;
           if (!params.quiet) {
@@ -1257,7 +1398,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
           }
         }
       }
-      for (Index a : freed) free[a] = 0;
+      for (Index a : free_list) free[a] = 0;
     }
     if (!params.quiet && result.neighbourhoods_improved) std::fprintf(stderr, "\n");
     summary.status = ilp::SolveStatus::Feasible;  // no bound: a neighbourhood optimum is not a global one
@@ -1348,5 +1489,71 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
                   " triangle-equivalents";
   return result;
 }
+
+namespace detail {
+
+namespace {
+struct Prepared {
+  std::vector<double> importance;
+  Groups groups;
+  GroupConstraints gc;
+  FaceGroups fg;
+  std::vector<std::uint8_t> y;
+};
+Prepared prepare(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                 const SelectionParams& params, const std::vector<std::uint8_t>& edge_kept) {
+  Prepared p;
+  p.importance = edge_importance(mesh, conn, params.importance_cap);
+  p.groups = make_groups(conn, analysis, p.importance, params);
+  p.gc = make_group_constraints(mesh, conn, p.groups, analysis, params);
+  p.fg = make_face_groups(mesh, conn, p.groups);
+  p.y.assign(p.groups.count, 1);
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (!edge_kept[e]) p.y[p.groups.edge_group[e]] = 0;
+  return p;
+}
+}  // namespace
+
+ilp::Model neighbourhood_model(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                               std::uint64_t target, const SelectionParams& params,
+                               const std::vector<std::uint8_t>& edge_kept, const std::vector<Index>& free_edges,
+                               bool indexed) {
+  const Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  std::vector<std::uint8_t> free(p.groups.count, 0);
+  std::vector<Index> free_list;
+  for (Index e : free_edges) {
+    const Index grp = p.groups.edge_group[e];
+    if (!p.groups.fixed[grp] && !free[grp]) {
+      free[grp] = 1;
+      free_list.push_back(grp);
+    }
+  }
+  std::sort(free_list.begin(), free_list.end());
+  const ScopeIndex index = make_scope_index(p.groups, p.gc, p.fg);
+  std::uint64_t count = 0;
+  for (Index f = 0; f + 1 < p.fg.offsets.size(); ++f) count += face_count(p.fg, f, p.y);
+  ModelBuilder sub(mesh, conn, analysis, p.groups, p.gc, p.fg, p.importance, params);
+  if (indexed) sub.set_scope(free, p.y, index, free_list, count);
+  else sub.set_scope(free, p.y);
+  sub.build(target, true);
+  sub.model.set_initial_solution(sub.complete(p.y, target));
+  return ilp::without_fixed_columns(sub.model).model;
+}
+
+std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                       std::uint64_t target, const SelectionParams& params,
+                                       const std::vector<std::uint8_t>& edge_kept, double seconds) {
+  Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  std::vector<Index> adj_offsets, adjacent;
+  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  FlipSearchStats stats;
+  const std::vector<std::uint8_t> y =
+      flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);
+  std::vector<std::uint8_t> kept(conn.num_edges);
+  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
+  return kept;
+}
+
+}  // namespace detail
 
 }  // namespace quadlod

@@ -186,4 +186,25 @@ std::uint64_t predicted_tri_equivalent(const PolyMesh& mesh, const Connectivity&
 std::uint64_t predicted_new_triangles(const PolyMesh& mesh, const Connectivity& conn,
                                       const std::vector<std::uint8_t>& edge_kept);
 
+/// Internals exposed for tests (tests/test_formulation.cpp); not part of the stage's interface.
+namespace detail {
+
+/// The fast model of one neighbourhood of the large-neighbourhood search around the selection
+/// `edge_kept` (one bit per edge, uniform per group), with the groups of `free_edges` free and
+/// every other group fixed, built by scanning every face and cluster (indexed = false) or
+/// through the per-group index the search uses (true); fixed columns substituted out
+/// (ilp::without_fixed_columns). Both must give the same model up to the objective offset.
+ilp::Model neighbourhood_model(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                               std::uint64_t target, const SelectionParams& params,
+                               const std::vector<std::uint8_t>& edge_kept, const std::vector<Index>& free_edges,
+                               bool indexed);
+
+/// The flip/swap/chain/exchange local search of select_edges() run for `seconds` from the
+/// selection `edge_kept` (uniform per group, N' in Eq. 2's band); returns the edge bits it ends at.
+std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                       std::uint64_t target, const SelectionParams& params,
+                                       const std::vector<std::uint8_t>& edge_kept, double seconds);
+
+}  // namespace detail
+
 }  // namespace quadlod
