@@ -42,7 +42,7 @@ struct SimplifyOptions {
   /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).
   std::string strategy = "auto";
   /// Groups freed per neighbourhood MIP (docs/parameters.md, "Solver strategy").
-  Index neighbourhood_groups = 400;
+  Index neighbourhood_groups = 50;
   std::string solver = "cbc";
 
   // --- rounds (beyond the paper) ------------------------------------------------------------

@@ -1189,6 +1189,111 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
   return std::move(st.y);
 }
 
+// Simulated annealing over the local-search moves (beyond the paper; docs/formulation.md,
+// "Speed"): random single flips, swaps with an adjacent group of the other value, and chains of
+// random length along λ_tri split partners (see chain_moves), each evaluated exactly through the
+// incremental state, never leaving Eq. 2's band or breaking Eq. 8; a worsening move of Δ is
+// taken with probability exp(−Δ/T), T falling geometrically from t0 to t1 over the budget (time,
+// or anneal_moves_per_group moves per free group, whichever ends first). The
+// best selection seen is returned. Microseconds per move, so millions of moves fit where the
+// neighbourhood MIPs manage a few hundred; the MIPs then polish its result.
+struct AnnealStats {
+  std::int64_t moves = 0, accepted = 0;
+};
+
+std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                 std::vector<std::uint8_t> y, std::uint64_t target, const SelectionParams& params,
+                                 double seconds, const std::vector<Index>& adj_offsets,
+                                 const std::vector<Index>& adjacent, AnnealStats& stats) {
+  Stopwatch clock;
+  SelectionState st(g, gc, fg, std::move(y));
+  const double n = double(target), band = params.epsilon_n * n;
+  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
+  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  std::vector<Index> movable;
+  for (Index grp = 0; grp < g.count; ++grp)
+    if (!g.fixed[grp]) movable.push_back(grp);
+  std::vector<std::uint8_t> best_y = st.y;
+  if (movable.empty() || seconds <= 0.0) return best_y;
+  std::mt19937_64 rng(params.solve.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double current = 0.0, best = 0.0;  // relative to the start
+  std::vector<std::pair<Index, std::int64_t>> flipped;
+  std::vector<Index> queue;
+  std::vector<std::uint32_t> stamp(g.count, 0);
+  std::uint32_t round = 0;
+  const double t0 = params.anneal_t0, t1 = params.anneal_t1;
+  double temperature = t0;
+  // Flips grp if allowed; false (nothing done) when a collapse would break Eq. 8.
+  auto apply = [&](Index grp, double& rest) {
+    if (st.y[grp] && !st.may_collapse(grp)) return false;
+    const std::int64_t dc = st.delta_count(grp);
+    rest += st.delta_rest(grp, params);
+    st.flip(grp, dc);
+    flipped.emplace_back(grp, dc);
+    return true;
+  };
+  auto undo = [&] {
+    while (!flipped.empty()) {
+      st.flip(flipped.back().first, -flipped.back().second);
+      flipped.pop_back();
+    }
+  };
+  // The schedule runs on time or on moves, whichever ends first (small meshes: moves).
+  const double max_moves = params.anneal_moves_per_group * double(movable.size());
+  for (;; ++stats.moves) {
+    if ((stats.moves & 1023) == 0) {
+      const double progress = std::max(clock.seconds() / seconds, double(stats.moves) / max_moves);
+      if (progress >= 1.0) break;
+      temperature = t0 * std::pow(t1 / t0, progress);
+    }
+    const Index a = movable[rng() % movable.size()];
+    const std::int64_t c0 = st.count;
+    double rest = 0.0;
+    flipped.clear();
+    const std::uint64_t kind = rng() % 3;
+    if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
+      if (!apply(a, rest)) continue;
+    } else if (kind == 1) {  // swap with an adjacent group of the other value
+      const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
+      if (g.fixed[b] || st.y[b] == st.y[a]) continue;
+      const Index keep = st.y[a] ? b : a, drop = st.y[a] ? a : b;  // keep first: never breaks Eq. 8
+      apply(keep, rest);
+      if (!apply(drop, rest)) {
+        undo();
+        continue;
+      }
+    } else {  // chain along split partners of the same value
+      const std::uint8_t v = st.y[a];
+      const std::size_t length = 2 + rng() % 15;
+      queue.assign(1, a);
+      stamp[a] = ++round;
+      for (std::size_t head = 0; head < queue.size() && flipped.size() < length; ++head) {
+        const Index x = queue[head];
+        if (st.y[x] != v || !apply(x, rest)) continue;
+        for (Index b : gc.group_split[x])
+          if (!g.fixed[b] && stamp[b] != round && st.y[b] == v) {
+            stamp[b] = round;
+            queue.push_back(b);
+          }
+      }
+      if (flipped.empty()) continue;
+    }
+    const double delta = count_term(st.count) - count_term(c0) + rest;
+    if (!in_band(st.count) || (delta > 0.0 && unit(rng) >= std::exp(-delta / temperature))) {
+      undo();
+      continue;
+    }
+    ++stats.accepted;
+    current += delta;
+    if (current < best - 1e-9) {
+      best = current;
+      best_y = st.y;
+    }
+  }
+  return best_y;
+}
+
 // Groups that share a face, as CSR.
 void group_adjacency(const Groups& g, const FaceGroups& fg, std::vector<Index>& offsets,
                      std::vector<Index>& adjacent) {
@@ -1416,10 +1521,26 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   // solve (skipped for a greedy-only run and when the greedy misses the band).
   std::vector<std::uint8_t> start_y = greedy.y;
   if (reachable && time_limit > 0.0) {
+    // Fast formulation: simulated annealing from the greedy selection until anneal_time_fraction
+    // of the budget has passed, then the deterministic local search as a final descent.
+    if (params.anneal_time_fraction > 0.0 && params.formulation == Formulation::Fast) {
+      Stopwatch anneal_clock;
+      AnnealStats as;
+      start_y = anneal(groups, gc, fg, std::move(start_y), target, params,
+                       params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent, as);
+      result.anneal_moves = as.moves;
+      result.anneal_accepted = as.accepted;
+      result.seconds_anneal = anneal_clock.seconds();
+    }
     Stopwatch flip_clock;
     FlipSearchStats fs;
-    start_y = flip_search(groups, gc, fg, std::move(start_y), target, params,
-                          params.flip_search_time_fraction * time_limit, adj_offsets, adjacent, fs);
+    // After annealing the descent only gets what is left up to 90 % of the budget (the
+    // neighbourhood MIPs and building the model need the rest).
+    const double flip_budget =
+        result.anneal_moves > 0
+            ? std::min(params.flip_search_time_fraction * time_limit, std::max(0.0, 0.9 * time_limit - clock.seconds()))
+            : params.flip_search_time_fraction * time_limit;
+    start_y = flip_search(groups, gc, fg, std::move(start_y), target, params, flip_budget, adj_offsets, adjacent, fs);
     result.flip_passes = fs.passes;
     result.flips = fs.flips;
     result.swaps = fs.swaps;
@@ -1443,14 +1564,15 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   const bool neighbourhoods =
       params.formulation == Formulation::Fast &&
       (params.strategy == SelectionParams::Strategy::Neighbourhoods ||
-       (params.strategy == SelectionParams::Strategy::Auto && free_groups > params.neighbourhood_groups));
+       (params.strategy == SelectionParams::Strategy::Auto && free_groups > params.whole_model_groups));
   result.strategy = time_limit > 0.0 ? (neighbourhoods ? "neighbourhoods" : "whole") : "greedy";
   if (reachable) {
     result.greedy_objective = banded.model.evaluate(banded.complete(greedy.y, target));
     result.flip_search_objective = banded.model.evaluate(banded_start);
     // The budget covers the whole selection: what building the model and the greedy took is
     // subtracted (at least 10 % of it is left to the solver).
-    const double budget = std::max(0.1 * time_limit, time_limit - clock.seconds());
+    // (After annealing, which already ran to its share of the budget, nothing is guaranteed.)
+    const double budget = std::max(result.anneal_moves > 0 ? 0.0 : 0.1 * time_limit, time_limit - clock.seconds());
     if (time_limit > 0.0 && neighbourhoods) {
       solution = banded.complete(neighbourhood_search(start_y, budget), target);
     } else {
@@ -1546,6 +1668,9 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
   std::vector<Index> adj_offsets, adjacent;
   group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  AnnealStats as;
+  if (params.anneal_time_fraction > 0.0)
+    p.y = anneal(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as);
   FlipSearchStats stats;
   const std::vector<std::uint8_t> y =
       flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);

@@ -81,14 +81,19 @@ struct SelectionParams {
   ///                   restricted to `neighbourhood_groups` adjacent groups (everything else
   ///                   fixed) is solved again and again over the mesh, keeping every
   ///                   improvement, until a full sweep improves nothing or time runs out.
-  ///   Auto:           Whole when all free groups fit in one neighbourhood, else Neighbourhoods.
+  ///   Auto:           Whole when at most whole_model_groups groups are free, else Neighbourhoods.
   ///                   Measured at ratio 0.4 with a 5 s budget (docs/parameters.md): the whole
   ///                   model never improved on the greedy start on any corpus mesh, even at 2–16k
   ///                   rows, while neighbourhoods improved it on most.
   /// The exact formulation always solves the whole model (it is the paper's reference).
   enum class Strategy { Auto, Whole, Neighbourhoods };
   Strategy strategy = Strategy::Auto;
-  Index neighbourhood_groups = 400;
+  /// Free groups per neighbourhood MIP. Measured on flightgear_c172p at 0.4, 5 s, before the
+  /// annealing existed (docs/formulation.md, "Speed"): 25 and 50 reached about the same, 100–400
+  /// worse (fewer neighbourhoods solved: CBC's time grows faster than the neighbourhood).
+  Index neighbourhood_groups = 50;
+  /// Strategy Auto solves the whole model when at most this many groups are free.
+  Index whole_model_groups = 400;
   /// Time limit of one neighbourhood MIP, seconds.
   double neighbourhood_time_limit = 0.1;
   /// Whether neighbourhood MIPs run in a child process like whole solves (ilp::SolveParams::
@@ -107,6 +112,14 @@ struct SelectionParams {
   /// Chain moves in the local search: runs of consecutive segments of a poly-chord (groups
   /// linked by λ_tri split pairs) flipped as one move (docs/formulation.md, "Speed").
   bool chain_moves = true;
+  /// Simulated annealing after the local search (fast formulation): it runs until this fraction
+  /// of the time limit has passed since select_edges() began, from temperature anneal_t0 down to
+  /// anneal_t1 (in Eq. 9 units); 0 = off (docs/formulation.md, "Speed").
+  double anneal_time_fraction = 0.8;
+  double anneal_t0 = 8.0;
+  double anneal_t1 = 0.05;
+  /// The annealing also ends after this many moves per free group (small meshes).
+  double anneal_moves_per_group = 1000.0;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
@@ -158,6 +171,8 @@ struct SelectionResult {
   double flip_search_objective = 0.0;   ///< Eq. 9 after the flip/swap local search
   Index flip_passes = 0, flips = 0, swaps = 0, exchanges = 0, chains = 0;
   double seconds_flip_search = 0.0;
+  std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
+  double seconds_anneal = 0.0;
   SelectionModelStats model;
   double seconds_build = 0.0;
   double seconds_greedy = 0.0;
@@ -199,8 +214,9 @@ ilp::Model neighbourhood_model(const PolyMesh& mesh, const Connectivity& conn, c
                                const std::vector<std::uint8_t>& edge_kept, const std::vector<Index>& free_edges,
                                bool indexed);
 
-/// The flip/swap/chain/exchange local search of select_edges() run for `seconds` from the
-/// selection `edge_kept` (uniform per group, N' in Eq. 2's band); returns the edge bits it ends at.
+/// The local search of select_edges() from the selection `edge_kept` (uniform per group, N' in
+/// Eq. 2's band): simulated annealing (if params.anneal_time_fraction > 0) for up to `seconds`,
+/// then the flip/swap/chain/exchange descent for up to `seconds`; returns the edge bits it ends at.
 std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                        std::uint64_t target, const SelectionParams& params,
                                        const std::vector<std::uint8_t>& edge_kept, double seconds);
