@@ -1,0 +1,80 @@
+"""Selection quality vs time budget (issue 4). Run through bench/selection_quality.
+
+For every mesh × ratio × formulation × time limit it runs
+    quadlod -q simplify MESH -o OUT --ratio R --time-limit S --max-rounds 1 --max-passes 1
+            --formulation F
+            --threads 1 --report REPORT [extra args]
+one at a time (the machine is shared: timings are wall clock), and reads report.selection.
+Reports are kept in --out and reused (delete them to re-run). The gap of a run is
+(objective − best) / |best|, best = the lowest objective of any run on that mesh and ratio (both
+formulations optimise the same Eq. 9); `proven` is the solver's own gap where it has a bound
+(whole-model solves). `load` is the 1-minute load average when the run started.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_MESHES = ["flightgear_c172p", "flightgear_cg57_cruiser_hd"]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quadlod", default=os.path.join(ROOT, "build", "quadlod"))
+    ap.add_argument("--corpus", default=os.path.join(ROOT, "..", "shared", "corpus"))
+    ap.add_argument("--meshes", default=",".join(DEFAULT_MESHES), help="comma-separated corpus names")
+    ap.add_argument("--ratios", default="0.4", help="comma-separated, e.g. 0.8,0.6,0.4,0.2")
+    ap.add_argument("--formulations", default="fast,exact")
+    ap.add_argument("--limits", default="5,180", help="comma-separated --time-limit values, seconds")
+    ap.add_argument("--out", default="/tmp/quadlod_selection_quality", help="reports and outputs")
+    ap.add_argument("--tag", default="", help="suffix of the report names (to keep variants apart)")
+    ap.add_argument("extra", nargs="*", help="more simplify arguments, after --")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for mesh in a.meshes.split(","):
+        src = os.path.join(a.corpus, mesh + ".obj")
+        for ratio in a.ratios.split(","):
+            for form in a.formulations.split(","):
+                for limit in a.limits.split(","):
+                    name = f"{mesh}_r{ratio}_{form}_t{limit}{a.tag}"
+                    report = os.path.join(a.out, name + ".json")
+                    meta = os.path.join(a.out, name + ".load")
+                    if not os.path.exists(report):
+                        load = open("/proc/loadavg").read().split()[0]
+                        cmd = [a.quadlod, "-q", "simplify", src, "-o", os.path.join(a.out, name + ".obj"),
+                               "--ratio", ratio, "--time-limit", limit, "--max-rounds", "1",
+                               "--max-passes", "1", "--formulation", form, "--threads", "1", "--report", report] + a.extra
+                        print("running:", " ".join(cmd), file=sys.stderr, flush=True)
+                        t = time.time()
+                        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+                        with open(meta, "w") as f:
+                            f.write(f"{load} {time.time() - t:.2f}\n")
+                    load = open(meta).read().split()[0] if os.path.exists(meta) else "?"
+                    s = json.load(open(report))["selection"]
+                    rows.append(dict(mesh=mesh, ratio=ratio, form=form, limit=limit, load=load, s=s))
+    best = {}
+    for r in rows:
+        key = (r["mesh"], r["ratio"])
+        best[key] = min(best.get(key, float("inf")), r["s"]["objective"])
+    print("| mesh | ratio | formulation | limit s | rows | cols | nonzeros | objective | gap to best | proven gap "
+          "| N' / N | select s | neighbourhoods | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        s = r["s"]
+        b = best[(r["mesh"], r["ratio"])]
+        gap = (s["objective"] - b) / max(abs(b), 1e-9) * 100
+        solver = s.get("solver", {})
+        proven = solver.get("gap")
+        proven = f"{100 * proven:.1f} %" if isinstance(proven, (int, float)) and s.get("strategy") == "whole" else "–"
+        print(f"| {r['mesh']} | {r['ratio']} | {r['form']} | {r['limit']} | {s['formulation_rows']} "
+              f"| {s['formulation_cols']} | {s['formulation_nonzeros']} | {s['objective']:.1f} | {gap:.2f} % "
+              f"| {proven} | {s['predicted']} / {s['target']} | {s['seconds']:.2f} "
+              f"| {s.get('neighbourhoods', 0)} | {r['load']} |")
+
+
+if __name__ == "__main__":
+    main()
