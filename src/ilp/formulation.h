@@ -103,8 +103,9 @@ struct SelectionParams {
   bool isolate_neighbourhoods = false;
   /// Neighbourhood MIPs as plain branch-and-bound (ilp::SolveParams::light).
   bool light_neighbourhoods = true;
-  /// Budget of the flip/swap local search that polishes the greedy start, as a fraction of the
-  /// time limit (it usually converges in far less).
+  /// Budget of the flip/swap/chain/exchange local search that polishes the greedy (or annealed)
+  /// start, as a fraction of the time limit (it usually converges in far less; after annealing
+  /// it stops at 90 % of the time limit).
   double flip_search_time_fraction = 0.3;
   /// Pair exchanges in the local search: keep one collapsed group and collapse one kept group
   /// anywhere on the mesh as one move (docs/formulation.md, "Speed").
@@ -112,9 +113,11 @@ struct SelectionParams {
   /// Chain moves in the local search: runs of consecutive segments of a poly-chord (groups
   /// linked by λ_tri split pairs) flipped as one move (docs/formulation.md, "Speed").
   bool chain_moves = true;
-  /// Simulated annealing after the local search (fast formulation): it runs until this fraction
-  /// of the time limit has passed since select_edges() began, from temperature anneal_t0 down to
-  /// anneal_t1 (in Eq. 9 units); 0 = off (docs/formulation.md, "Speed").
+  /// Simulated annealing from the greedy start, before the local search (fast formulation, a
+  /// time limit > 0, greedy in the band): it runs until this fraction of the time limit has
+  /// passed since select_edges() began, its temperature falling from anneal_t0 to anneal_t1
+  /// (Eq. 9 units; one emptied Eq. 6 cluster costs λ_geo = 4); 0 = off. t0 measured on c172p
+  /// (docs/formulation.md, "Speed"). Wall-clock driven, so the result depends on the load.
   double anneal_time_fraction = 0.8;
   double anneal_t0 = 8.0;
   double anneal_t1 = 0.05;
