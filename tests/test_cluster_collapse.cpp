@@ -93,6 +93,14 @@ void expect_valid_output(const PolyMesh& in, const ClusterCollapseResult& r) {
   }
 }
 
+// The chord of column i of make_grid(n, m): its horizontal edges (i, j)–(i + 1, j), j = 0..m, whose
+// collapse merges the vertical lines x = i/n and x = (i+1)/n.
+std::vector<std::pair<Index, Index>> column_chord(Index n, Index m, Index i) {
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= m; ++j) chord.emplace_back(j * (n + 1) + i, j * (n + 1) + i + 1);
+  return chord;
+}
+
 // --- known answers -------------------------------------------------------------------------------
 
 TEST(ClusterCollapse, NothingCollapsedIsIdentity) {
@@ -137,8 +145,7 @@ TEST(ClusterCollapse, GridColumnChordRemovesOneColumn) {
   const PolyMesh in = make_grid(n, m);
   const Connectivity conn = build_connectivity(in);
   auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
-  std::vector<std::pair<Index, Index>> chord;
-  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const auto chord = column_chord(n, m, 2);
   const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
   expect_valid_output(in, r);
   EXPECT_EQ(r.mesh.num_faces(), (n - 1) * m);
@@ -522,8 +529,7 @@ TEST(ClusterCollapseFeatures, MergedVerticesStayOnTheSeamAndGetTheUvOfTheirSide)
   const PolyMesh in = feature_test::grid_with_seam_column(n, m, 3, 0.5);
   const Connectivity conn = build_connectivity(in);
   auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
-  std::vector<std::pair<Index, Index>> chord;
-  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const auto chord = column_chord(n, m, 2);
   const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
   expect_valid_output(in, r);
   EXPECT_EQ(r.stats.total_refusals(), 0u);
@@ -563,8 +569,7 @@ TEST(ClusterCollapseFeatures, ClusterJoiningTwoMaterialBordersIsRefused) {
   feature_test::paint_columns(in, n, {"A", "B"}, {0, 0, 1, 0, 0});
   const Connectivity conn = build_connectivity(in);
   auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
-  std::vector<std::pair<Index, Index>> chord;
-  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(2, j), id(3, j));
+  const auto chord = column_chord(n, m, 2);
   const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
   expect_valid_output(in, r);
   EXPECT_EQ(r.stats.refusals(CollapseRefusal::Feature), m + 1);
@@ -572,8 +577,7 @@ TEST(ClusterCollapseFeatures, ClusterJoiningTwoMaterialBordersIsRefused) {
   EXPECT_EQ(r.mesh.num_faces(), in.num_faces());
   // The same chord next to the border (column 1, A|A on one side) is fine: the cluster holds one
   // strict run (the border x = 2/5) and lands on it.
-  std::vector<std::pair<Index, Index>> beside;
-  for (Index j = 0; j <= m; ++j) beside.emplace_back(id(1, j), id(2, j));
+  const auto beside = column_chord(n, m, 1);
   const ClusterCollapseResult b = collapse_clusters(in, conn, select(conn, beside));
   expect_valid_output(in, b);
   EXPECT_EQ(b.stats.total_refusals(), 0u);
@@ -586,8 +590,7 @@ TEST(ClusterCollapseFeatures, FeatureCornerDoesNotMove) {
   const PolyMesh in = make_grid(n, m);
   const Connectivity conn = build_connectivity(in);
   auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
-  std::vector<std::pair<Index, Index>> chord;
-  for (Index j = 0; j <= m; ++j) chord.emplace_back(id(0, j), id(1, j));
+  const auto chord = column_chord(n, m, 0);
   const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, chord));
   expect_valid_output(in, r);
   EXPECT_EQ(r.mesh.positions[r.vertex_map[id(0, 0)]], in.positions[id(0, 0)]);

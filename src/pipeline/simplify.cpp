@@ -194,20 +194,23 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   const bool reducing = target < out.input_tri_equivalent;
   const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
   std::vector<std::uint8_t> pinned;
+  std::optional<FeatureEdges> feat;  // computed once per pass: pins here, the collapse's rules
+  ClusterCollapseParams pass_cp = cp;
   if (options.features) {
     clock = Stopwatch();
-    const FeatureEdges feat = find_feature_edges(input, conn, cp.features);
-    pinned = feature_pins(conn, feat, out.feature_pins);
+    feat = find_feature_edges(input, conn, cp.features);
+    pinned = feature_pins(conn, *feat, out.feature_pins);
+    pass_cp.feature_edges = &*feat;
     report["features"] = {
-        {"feature_edges", feat.feature_edges},
-        {"boundary_edges", feat.edges_with_bit[0]},
-        {"nonmanifold_edges", feat.edges_with_bit[1]},
-        {"uv_seam_edges", feat.edges_with_bit[2]},
-        {"normal_seam_edges", feat.edges_with_bit[3]},
-        {"material_border_edges", feat.edges_with_bit[4]},
-        {"hard_edges", feat.edges_with_bit[5]},
-        {"lines", feat.num_lines},
-        {"corners", feat.corners},
+        {"feature_edges", feat->feature_edges},
+        {"boundary_edges", feat->edges_with_bit[0]},
+        {"nonmanifold_edges", feat->edges_with_bit[1]},
+        {"uv_seam_edges", feat->edges_with_bit[2]},
+        {"normal_seam_edges", feat->edges_with_bit[3]},
+        {"material_border_edges", feat->edges_with_bit[4]},
+        {"hard_edges", feat->edges_with_bit[5]},
+        {"lines", feat->num_lines},
+        {"corners", feat->corners},
         {"pinned_edges", out.feature_pins},
         {"seconds", clock.seconds()},
     };
@@ -240,7 +243,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
                  std::to_string(repaired.stats.splits) + " splits" + tag);
 
     clock = Stopwatch();
-    ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, cp);
+    ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, pass_cp);
     if (collapsed.status != ClusterCollapseStatus::Ok) {
       out.error = collapsed.error;
       return out;

@@ -131,7 +131,8 @@ class Collapser {
   std::vector<VertexTerms> terms_;
   std::vector<std::int8_t> input_nm_;  // input vertex non-manifold: 1 / 0, −1 not computed yet
   bool features_on_ = false;
-  FeatureEdges feat_;
+  FeatureEdges own_feat_;
+  const FeatureEdges* feat_ptr_ = nullptr;
   FeatureReference own_reference_;
   const FeatureReference* reference_ = nullptr;
 
@@ -213,10 +214,14 @@ void Collapser::precompute() {
   input_nm_.assign(nv_, -1);
   features_on_ = params_.respect_features;
   if (features_on_) {
-    feat_ = find_feature_edges(mesh_, conn_, params_.features);
+    feat_ptr_ = params_.feature_edges;
+    if (!feat_ptr_) {
+      own_feat_ = find_feature_edges(mesh_, conn_, params_.features);
+      feat_ptr_ = &own_feat_;
+    }
     reference_ = params_.feature_reference;
     if (!reference_) {
-      own_reference_ = make_feature_reference(mesh_, conn_, feat_);
+      own_reference_ = make_feature_reference(mesh_, conn_, *feat_ptr_);
       reference_ = &own_reference_;
     }
   }
@@ -452,10 +457,10 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
   Index corners = 0, corner = kInvalidIndex;
   bool strict = false, any = false;
   for (Index m : members(r)) {
-    if (!feat_.on_feature(m)) continue;
+    if (!feat_ptr_->on_feature(m)) continue;
     any = true;
-    strict = strict || feat_.on_strict(m);
-    if (feat_.vertex_corner[m]) {
+    strict = strict || feat_ptr_->on_strict(m);
+    if (feat_ptr_->vertex_corner[m]) {
       ++corners;
       corner = m;
     }
@@ -471,14 +476,14 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
   edges_tmp_.clear();
   Index line = kInvalidIndex;
   for (Index m : members(r)) {
-    if (!feat_.on_feature(m)) continue;
+    if (!feat_ptr_->on_feature(m)) continue;
     for (Index c : conn_.corners_at_vertex(m))
       for (Index ec : {c, conn_.corner_prev[c]}) {
         const Index e = conn_.corner_edge[ec];
-        if (!feat_.is_feature(e) || (strict && !feat_.is_strict(e))) continue;
+        if (!feat_ptr_->is_feature(e) || (strict && !feat_ptr_->is_strict(e))) continue;
         if (!strict) {
-          if (line == kInvalidIndex) line = feat_.edge_line[e];
-          else if (feat_.edge_line[e] != line) return false;
+          if (line == kInvalidIndex) line = feat_ptr_->edge_line[e];
+          else if (feat_ptr_->edge_line[e] != line) return false;
         }
         edges_tmp_.push_back(e);
       }
@@ -518,9 +523,9 @@ bool Collapser::features_valid(Index r) {
   const auto ms = members(r);
   Index strict_members = 0, strict_corners = 0;
   for (Index m : ms)
-    if (feat_.on_strict(m)) {
+    if (feat_ptr_->on_strict(m)) {
       ++strict_members;
-      strict_corners += feat_.vertex_corner[m];
+      strict_corners += feat_ptr_->vertex_corner[m];
     }
   if (strict_corners > 1) return false;
   if (strict_members <= 1) return true;
@@ -532,11 +537,11 @@ bool Collapser::features_valid(Index r) {
   UnionFind uf(e - b);
   Index parts = strict_members;
   for (Index m : ms) {
-    if (!feat_.on_strict(m)) continue;
+    if (!feat_ptr_->on_strict(m)) continue;
     for (Index c : conn_.corners_at_vertex(m))
       for (Index ec : {c, conn_.corner_prev[c]}) {
         const Index edge = conn_.corner_edge[ec];
-        if (!collapsed_[edge] || !feat_.is_strict(edge)) continue;
+        if (!collapsed_[edge] || !feat_ptr_->is_strict(edge)) continue;
         const Index o = conn_.other_vertex(edge, m);
         if (o == m || root_[o] != r) continue;
         const Index lm = local(m), lo = local(o);
@@ -959,7 +964,7 @@ void Collapser::check_vertex(Index v) {
 // short is refused here instead. Uses nbr_ of check_vertex.
 void Collapser::check_feature_edges(Index v) {
   bool strict_member = false;
-  for (Index m : members(v)) strict_member = strict_member || feat_.on_strict(m);
+  for (Index m : members(v)) strict_member = strict_member || feat_ptr_->on_strict(m);
   if (!strict_member) return;
   const double tol = std::max(0.0, params_.feature_tolerance);
   constexpr std::uint8_t kKinds[4] = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam, kFeatureMaterialBorder};
@@ -972,7 +977,7 @@ void Collapser::check_feature_edges(Index v) {
       for (Index c : conn_.corners_at_vertex(m))
         for (Index ec : {c, conn_.corner_prev[c]}) {
           const Index e = conn_.corner_edge[ec];
-          if (feat_.is_strict(e) && root_[conn_.other_vertex(e, m)] == w) kinds |= feat_.edge_bits[e];
+          if (feat_ptr_->is_strict(e) && root_[conn_.other_vertex(e, m)] == w) kinds |= feat_ptr_->edge_bits[e];
         }
     if (!kinds) continue;
     const Vec3 &a = pos_[v], &b = pos_[w];

@@ -129,6 +129,9 @@ struct ClusterCollapseParams {
   /// Lines feature_tolerance is measured against (borrowed; must outlive the call). nullptr: the
   /// strict lines of the mesh being collapsed.
   const FeatureReference* feature_reference = nullptr;
+  /// The features of the mesh being collapsed, when the caller has them already (borrowed; must
+  /// match `features` and `conn`). nullptr: computed here.
+  const FeatureEdges* feature_edges = nullptr;
 
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
