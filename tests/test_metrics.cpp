@@ -666,6 +666,129 @@ Vec2 oracle_uv(const std::array<Vec3, 3>& t, const std::array<Vec2, 3>& uv, cons
   return uv[0] + w[0] * (uv[1] - uv[0]) + w[1] * (uv[2] - uv[0]);
 }
 
+struct OracleUvError {
+  double mean = 0, max = 0;       ///< docs/metrics.md §6c, by brute force over all triangles
+  double naive_max = 0;           ///< the same without the self-seam candidates
+  std::size_t samples = 0;
+};
+
+/// uv_error of docs/metrics.md §6c with every nearest-point search done by brute force: the same
+/// normalisation and samples as evaluate(), votes with the coincident-island tie-break, the
+/// restricted nearest point and the self-seam candidates within reach.
+OracleUvError brute_force_uv_error(const PolyMesh& input, const PolyMesh& output, const EvalParams& params) {
+  const BoundingBox box = bounding_box(input);
+  const double s = 1.0 / box.longest_side();
+  const Vec3 c = 0.5 * (box.min + box.max);
+  auto scaled = [&](PolyMesh m) {
+    for (Vec3& p : m.positions) p = (p - c) * s;
+    return m;
+  };
+  const PolyMesh in = scaled(input), out = scaled(output);
+  const TriangleSoup soup_in = fan_triangulate(in), soup_out = fan_triangulate(out);
+  const SurfaceSamples samples = sample_triangles(soup_out, params.samples, params.seed, 1);
+  const Connectivity conn_in = build_connectivity(in);
+  const UvIslands is_in = find_uv_islands(in, conn_in, 0);
+  const UvIslands is_out = find_uv_islands(out, build_connectivity(out), 0);
+  const FeatureEdges fe_in = find_feature_edges(in, conn_in);
+  std::vector<char> self_seam(in.num_faces(), 0);
+  for (Index e = 0; e < conn_in.num_edges; ++e) {
+    const auto cs = conn_in.corners_of_edge(e);
+    if ((fe_in.edge_uv_seam_sets[e] & 1u) &&
+        is_in.face_island[conn_in.corner_face[cs[0]]] == is_in.face_island[conn_in.corner_face[cs[1]]])
+      self_seam[conn_in.corner_face[cs[0]]] = self_seam[conn_in.corner_face[cs[1]]] = 1;
+  }
+  auto tri_uv = [](const PolyMesh& m, const TriangleSoup& soup, std::size_t t) {
+    const Index f = soup.face[t];
+    Index k = 0;  // position of t in its face's fan
+    while (t > k && soup.face[t - k - 1] == f) ++k;
+    const UvSet& set = m.uv_sets[0];
+    const Index b = m.face_begin(f);
+    return std::array<Vec2, 3>{set.values[set.corner[b]], set.values[set.corner[b + k + 1]],
+                               set.values[set.corner[b + k + 2]]};
+  };
+  auto island_of = [&](std::size_t t) {
+    return triangle_area(soup_in.triangles[t]) > 0 ? is_in.face_island[soup_in.face[t]] : kInvalidIndex;
+  };
+  auto closest = [&](const Vec3& p, std::size_t t) {
+    const auto& tr = soup_in.triangles[t];
+    return closest_point_on_triangle(p, tr[0], tr[1], tr[2]);
+  };
+  auto uv_in = [&](std::size_t t, const Vec3& q) { return oracle_uv(soup_in.triangles[t], tri_uv(in, soup_in, t), q); };
+
+  const std::size_t n = samples.points.size();
+  std::vector<Vec2> uv_out(n);
+  std::map<std::pair<Index, Index>, int> votes;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& p = samples.points[k];
+    const std::size_t to = samples.triangle[k];
+    uv_out[k] = oracle_uv(soup_out.triangles[to], tri_uv(out, soup_out, to), p);
+    std::size_t t0 = 0;
+    std::vector<double> island_d2(is_in.num_islands, std::numeric_limits<double>::infinity());
+    std::vector<std::size_t> island_t(is_in.num_islands);
+    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
+      const double d2 = closest(p, t).distance_sq;
+      if (d2 < closest(p, t0).distance_sq) t0 = t;
+      const Index j = island_of(t);
+      if (j != kInvalidIndex && d2 < island_d2[j]) {
+        island_d2[j] = d2;
+        island_t[j] = t;
+      }
+    }
+    const Index j0 = island_of(t0);
+    if (j0 == kInvalidIndex) continue;
+    const double bound = 2.0 * std::sqrt(closest(p, t0).distance_sq) + 1e-9;
+    std::vector<std::pair<double, Index>> near;  // other islands within the bound, nearest first
+    for (Index j = 0; j < is_in.num_islands; ++j)
+      if (j != j0 && island_d2[j] < bound * bound) near.emplace_back(island_d2[j], j);
+    std::sort(near.begin(), near.end());
+    near.resize(std::min<std::size_t>(near.size(), 3));
+    Index best = j0;
+    double best_uv = (uv_in(t0, closest(p, t0).point) - uv_out[k]).squaredNorm();
+    for (const auto& [d2, j] : near) {
+      const double d_uv = (uv_in(island_t[j], closest(p, island_t[j]).point) - uv_out[k]).squaredNorm();
+      if (d_uv < best_uv || (d_uv == best_uv && j < best)) {
+        best_uv = d_uv;
+        best = j;
+      }
+    }
+    ++votes[{is_out.face_island[soup_out.face[to]], best}];
+  }
+  std::map<Index, std::pair<int, Index>> target;  // output island → (votes, input island)
+  for (const auto& [key, count] : votes)
+    if (count > target[key.first].first) target[key.first] = {count, key.second};
+
+  OracleUvError r;
+  double sum = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& p = samples.points[k];
+    const Index f_out = soup_out.face[samples.triangle[k]];
+    const Index j = target[is_out.face_island[f_out]].second;
+    std::size_t tj = 0;
+    double dj = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t)
+      if (island_of(t) == j && closest(p, t).distance_sq < dj) {
+        dj = closest(p, t).distance_sq;
+        tj = t;
+      }
+    double e = (uv_out[k] - uv_in(tj, closest(p, tj).point)).norm();
+    r.naive_max = std::max(r.naive_max, e / (is_in.uv_max[j] - is_in.uv_min[j]).norm());
+    double longest = 0;
+    for (Index cc = out.face_begin(f_out); cc < out.face_end(f_out); ++cc)
+      longest = std::max(longest, (out.positions[out.corner_vertex[out.next_corner(f_out, cc)]] -
+                                   out.positions[out.corner_vertex[cc]]).norm());
+    const double reach = std::sqrt(dj) + longest;
+    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t)
+      if (island_of(t) == j && self_seam[soup_in.face[t]] && closest(p, t).distance_sq <= reach * reach)
+        e = std::min(e, (uv_out[k] - uv_in(t, closest(p, t).point)).norm());
+    e /= (is_in.uv_max[j] - is_in.uv_min[j]).norm();
+    sum += e;
+    r.max = std::max(r.max, e);
+    ++r.samples;
+  }
+  r.mean = sum / double(r.samples);
+  return r;
+}
+
 TEST(EvalFeatures, UvErrorMatchesBruteForceOracle) {
   // Input: a bent 6×6 grid with a seam at x = ½. Output: a bent 4×4 grid (other bend), its own
   // UVs (u = x², v = y) and a seam at x = ½, so output samples near the seam have their
@@ -679,70 +802,35 @@ TEST(EvalFeatures, UvErrorMatchesBruteForceOracle) {
   const EvalParams params = small_params(1500, 500);
   const EvalResult r = evaluate(input, output, params);
   ASSERT_TRUE(r.ok()) << r.error;
+  const OracleUvError o = brute_force_uv_error(input, output, params);
+  EXPECT_EQ(r.uv_samples, o.samples);
+  EXPECT_NEAR(r.uv_error_mean, o.mean, 1e-12);
+  EXPECT_NEAR(r.uv_error_max, o.max, 1e-12);
+  EXPECT_GT(o.max, 0.05);  // the test measures something
+}
 
-  // Oracle: the same scaling and samples, brute-force nearest triangles.
-  const BoundingBox box = bounding_box(input);
-  const double s = 1.0 / box.longest_side();
-  const Vec3 c = 0.5 * (box.min + box.max);
-  auto scaled = [&](PolyMesh m) {
-    for (Vec3& p : m.positions) p = (p - c) * s;
-    return m;
-  };
-  const PolyMesh in = scaled(input), out = scaled(output);
-  const TriangleSoup soup_in = fan_triangulate(in), soup_out = fan_triangulate(out);
-  const SurfaceSamples samples = sample_triangles(soup_out, params.samples, params.seed, 1);
-  const UvIslands is_in = find_uv_islands(in, build_connectivity(in), 0);
-  const UvIslands is_out = find_uv_islands(out, build_connectivity(out), 0);
-  auto tri_uv = [](const PolyMesh& m, const TriangleSoup& soup, std::size_t t) {
-    const Index f = soup.face[t];
-    Index k = 0;  // position of t in its face's fan
-    while (t > k && soup.face[t - k - 1] == f) ++k;
-    const UvSet& set = m.uv_sets[0];
-    const Index b = m.face_begin(f);
-    return std::array<Vec2, 3>{set.values[set.corner[b]], set.values[set.corner[b + k + 1]],
-                               set.values[set.corner[b + k + 2]]};
-  };
-  auto brute = [&](const Vec3& p, auto&& accept) {
-    std::size_t best = 0;
-    TrianglePoint bp;
-    bp.distance_sq = std::numeric_limits<double>::infinity();
-    for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
-      if (!accept(t)) continue;
-      const auto& tr = soup_in.triangles[t];
-      const TrianglePoint q = closest_point_on_triangle(p, tr[0], tr[1], tr[2]);
-      if (q.distance_sq < bp.distance_sq) {
-        bp = q;
-        best = t;
-      }
-    }
-    return std::pair{best, bp.point};
-  };
-  std::map<std::pair<Index, Index>, int> votes;
-  std::vector<std::size_t> nearest(samples.points.size());
-  for (std::size_t k = 0; k < samples.points.size(); ++k) {
-    nearest[k] = brute(samples.points[k], [](std::size_t) { return true; }).first;
-    ++votes[{is_out.face_island[soup_out.face[samples.triangle[k]]], is_in.face_island[soup_in.face[nearest[k]]]}];
-  }
-  std::map<Index, std::pair<int, Index>> target;  // output island → (votes, input island)
-  for (const auto& [key, count] : votes)
-    if (count > target[key.first].first) target[key.first] = {count, key.second};
-  EXPECT_EQ(target[0].second, 0u);
-  EXPECT_EQ(target[1].second, 1u);
-  double sum = 0, mx = 0;
-  for (std::size_t k = 0; k < samples.points.size(); ++k) {
-    const Index ii = target[is_out.face_island[soup_out.face[samples.triangle[k]]]].second;
-    const auto [t, q] = brute(samples.points[k], [&](std::size_t t) { return is_in.face_island[soup_in.face[t]] == ii; });
-    const Vec2 uv_out = oracle_uv(soup_out.triangles[samples.triangle[k]], tri_uv(out, soup_out, samples.triangle[k]),
-                                  samples.points[k]);
-    const Vec2 uv_in = oracle_uv(soup_in.triangles[t], tri_uv(in, soup_in, t), q);
-    const double e = (uv_out - uv_in).norm() / (is_in.uv_max[ii] - is_in.uv_min[ii]).norm();
-    sum += e;
-    mx = std::max(mx, e);
-  }
-  EXPECT_EQ(r.uv_samples, samples.points.size());
-  EXPECT_NEAR(r.uv_error_mean, sum / double(samples.points.size()), 1e-12);
-  EXPECT_NEAR(r.uv_error_max, mx, 1e-12);
-  EXPECT_GT(mx, 0.05);  // the test measures something
+TEST(EvalFeatures, SelfSeamSidesAreToldApartByUv) {
+  // A cylinder unwrapped with one seam is one island whose two sides meet at the seam (u = 0 and
+  // u = 1). The output is the same cylinder turned by half a face (and 2 % wider), so its seam
+  // lies half a face past the input's: samples in that strip have their closest input point on
+  // the u ≈ 0 side while their own face's chart is the u ≈ 1 side. Their error must be the
+  // turn's UV offset, (1/32)/√2 ≈ 0.022, not the island's width (≈ 0.7).
+  const Index n = 16, m = 3;
+  const PolyMesh input = make_cylinder(n, m, 0.5, 1.0);
+  PolyMesh output = make_cylinder(n, m, 0.51, 1.0);
+  const double turn = std::numbers::pi / n;
+  for (Vec3& p : output.positions)
+    p = Vec3(std::cos(turn) * p.x() - std::sin(turn) * p.y(), std::sin(turn) * p.x() + std::cos(turn) * p.y(), p.z());
+  const EvalParams params = small_params(1500, 500);
+  const EvalResult r = evaluate(input, output, params);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const OracleUvError o = brute_force_uv_error(input, output, params);
+  EXPECT_NEAR(r.uv_error_mean, o.mean, 1e-12);
+  EXPECT_NEAR(r.uv_error_max, o.max, 1e-12);
+  EXPECT_GT(o.naive_max, 0.5);  // the island restriction alone picks the wrong side
+  const double offset = 1.0 / (2.0 * n) / std::sqrt(2.0);
+  EXPECT_LT(r.uv_error_max, 1.5 * offset);
+  EXPECT_NEAR(r.uv_error_mean, offset, 0.2 * offset);
 }
 
 // --- corpus ---------------------------------------------------------------------------------------------
