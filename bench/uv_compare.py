@@ -92,27 +92,17 @@ def parse_args(argv):
 
 
 def select_meshes(a):
-    d = a.mesh_dir
-    if not os.path.isdir(d):
-        sys.exit("bench/uv_compare: mesh folder %s not found (pass --mesh-dir DIR)" % d)
-    paths = sorted(os.path.join(d, f) for f in os.listdir(d) if f.lower().endswith(".obj"))
-    stems = {os.path.splitext(os.path.basename(m))[0]: m for m in paths}
-    if a.meshes:
-        want = [w[:-4] if w.lower().endswith(".obj") else w for w in
-                (x.strip() for x in a.meshes.split(",")) if w]
-        missing = [w for w in want if w not in stems]
-        if missing:
-            sys.exit("bench/uv_compare: not in %s: %s" % (d, ", ".join(missing)))
-        paths = [stems[w] for w in want]
+    """bench/run's selection (--mesh-dir, --meshes, smallest file first), then only the meshes
+    with UVs; --quick takes the smallest of those."""
+    paths = bench_run.select_meshes(argparse.Namespace(mesh_dir=a.mesh_dir, meshes=a.meshes, quick=False))
     with_uvs = [m for m in paths if has_uvs(m)]
     without = [os.path.basename(m) for m in paths if m not in with_uvs]
     if without:
         bench_run.log("uv_compare: skipping %d meshes without UVs: %s" % (len(without), ", ".join(without)))
-    with_uvs.sort(key=lambda m: (os.path.getsize(m), m))
     if a.quick and not a.meshes:
         with_uvs = with_uvs[:a.quick_meshes]
     if not with_uvs:
-        sys.exit("bench/uv_compare: no .obj mesh with UVs in %s" % d)
+        sys.exit("bench/uv_compare: no .obj mesh with UVs in %s" % a.mesh_dir)
     return [os.path.splitext(os.path.basename(m))[0] for m in with_uvs]
 
 
