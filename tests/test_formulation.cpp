@@ -405,7 +405,9 @@ TEST(Formulation, LocalSearchNeverWorsensAndKeepsEveryConstraint) {
         EXPECT_TRUE(eq8_holds(*p, kept));
         for (Index e = 0; e < p->conn.num_edges; ++e)
           if (pin[e]) EXPECT_TRUE(kept[e]) << "pinned edge " << e;
-        if (p == &small) EXPECT_GE(after, oracle_optimum(*p, target, sp) - 1e-9);
+        if (p == &small) {
+          EXPECT_GE(after, oracle_optimum(*p, target, sp) - 1e-9);
+        }
       }
     }
   }

@@ -171,7 +171,7 @@ struct SelectionResult {
   Index neighbourhood_sweeps = 0;       ///< full passes over the groups
   bool neighbourhoods_converged = false;  ///< a full sweep improved nothing
   double seconds_neighbourhood_build = 0.0;  ///< building the neighbourhood models
-  double flip_search_objective = 0.0;   ///< Eq. 9 after the flip/swap local search
+  double flip_search_objective = 0.0;   ///< Eq. 9 after annealing and the local search (the MIPs' start)
   Index flip_passes = 0, flips = 0, swaps = 0, exchanges = 0, chains = 0;
   double seconds_flip_search = 0.0;
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
