@@ -9,6 +9,7 @@
 #include "feature_test_util.h"
 #include "quadlod/generators.h"
 #include "quadlod/mesh.h"
+#include "quadlod/metrics.h"
 
 #include <gtest/gtest.h>
 
@@ -276,9 +277,12 @@ TEST(ClusterCollapse, CollapseThatFlipsAFaceIsRefused) {
   EXPECT_EQ(r.mesh.positions, in.positions);
   EXPECT_EQ(r.stats.rounds, 2u);
 
-  // Without the refusal the merged vertex would really have turned T over.
+  // Without the refusal the merged vertex would really have turned T over (the surface check
+  // sees it too: it must be off as well).
   ClusterCollapseParams lax;
   lax.flip_angle_deg = 180.0;
+  EXPECT_EQ(collapse_clusters(in, conn, select(conn, {{a, b}}), lax).stats.refusals(CollapseRefusal::Orientation), 1u);
+  lax.check_surface_orientation = false;
   const ClusterCollapseResult bad = collapse_clusters(in, conn, select(conn, {{a, b}}), lax);
   ASSERT_EQ(bad.mesh.num_faces(), 5u);
   EXPECT_LT(face_area_vector(bad.mesh, 0).z(), 0.0);  // (x, s, t) now faces down
@@ -286,6 +290,41 @@ TEST(ClusterCollapse, CollapseThatFlipsAFaceIsRefused) {
 
 // An open grid bent upward (z = 0.3 y²): collapsing a boundary edge keeps the merged vertex on the
 // straight boundary line y = 0, z = 0 (boundary constraint planes, consistent face planes).
+// The orientation guarantee measures against the *reference* surface (simplify passes the
+// original input's): against a copy of the grid with every face reversed, each face the column
+// collapse changes faces away from the surface under it, so every cluster is refused for that
+// reason and nothing is lost; without the check the same selection removes the column.
+TEST(ClusterCollapse, FaceFacingAwayFromTheReferenceSurfaceIsRefused) {
+  const Index n = 6, m = 4;
+  const PolyMesh in = make_grid(n, m);
+  PolyMesh reversed = in;
+  for (Index f = 0; f < reversed.num_faces(); ++f)
+    std::reverse(reversed.corner_vertex.begin() + reversed.face_begin(f),
+                 reversed.corner_vertex.begin() + reversed.face_end(f));
+  const SurfaceReference against_reversed = make_surface_reference(reversed);
+  const SurfaceReference against_itself = make_surface_reference(in);
+  const Connectivity conn = build_connectivity(in);
+  const auto kept = select(conn, column_chord(n, m, 2));
+
+  ClusterCollapseParams params;
+  params.surface_reference = &against_reversed;
+  const ClusterCollapseResult refused = collapse_clusters(in, conn, kept, params);
+  expect_valid_output(in, refused);
+  EXPECT_EQ(refused.mesh.num_faces(), n * m);
+  EXPECT_EQ(refused.stats.clusters, 0u);
+  EXPECT_GT(refused.stats.refusals(CollapseRefusal::Orientation), 0u);
+  EXPECT_EQ(refused.stats.total_refusals(), refused.stats.refusals(CollapseRefusal::Orientation));
+
+  params.surface_reference = &against_itself;
+  const ClusterCollapseResult accepted = collapse_clusters(in, conn, kept, params);
+  EXPECT_EQ(accepted.mesh.num_faces(), (n - 1) * m);
+  EXPECT_EQ(accepted.stats.total_refusals(), 0u);
+
+  params.surface_reference = &against_reversed;
+  params.check_surface_orientation = false;
+  EXPECT_EQ(collapse_clusters(in, conn, kept, params).mesh.num_faces(), (n - 1) * m);
+}
+
 TEST(ClusterCollapse, BoundaryEdgeCollapseKeepsBoundaryStraight) {
   PolyMesh in = make_grid(6, 4);
   for (Vec3& p : in.positions) p.z() = 0.3 * p.y() * p.y();
@@ -483,6 +522,11 @@ TEST(ClusterCollapseInvariants, RandomSelectionsGiveValidMeshes) {
           params.max_bisect_rounds = rounds;
           const ClusterCollapseResult r = collapse_clusters(nm.mesh, conn, kept, params);
           expect_valid_output(nm.mesh, r);
+          // The collapse's orientation rule is the one `eval` counts by (docs/metrics.md §6b).
+          EvalParams ep;
+          ep.samples = 1000;
+          ep.curve_samples = 1000;
+          EXPECT_EQ(evaluate(nm.mesh, r.mesh, ep).flipped_faces, 0u);
           EXPECT_LE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_in);
           EXPECT_GE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_wanted);
           if (seed == 1) {  // deterministic

@@ -226,6 +226,36 @@ TEST(EvalMetrics, ReversedFacesAreCountedAsFlipped) {
   EXPECT_EQ(evaluate(torus, torus, small_params()).flipped_faces, 0u);
 }
 
+// Two interpenetrating quads from makehuman_teeth_base (input faces 2162 and 2720, vertex
+// coordinates copied as numbers): the centroid of the first lies 0.0014 (normalised) from the
+// second, which faces the other way, and 0.0597 from the first's own fan triangles, which fold
+// away from its Newell normal. The input is like that; an output that keeps the face unchanged
+// replaced nothing and counts it in flipped_faces_kept, an output that moved it counts it flipped.
+TEST(EvalMetrics, InputFacesThatTheRuleFlagsAreCountedApartWhenKept) {
+  PolyMesh m;
+  m.positions = {{0.1553, 6.2913, 1.0111}, {0.1454, 6.2888, 1.0137}, {0.1542, 6.2776, 1.0364},
+                 {0.1569, 6.2871, 1.0324}, {0.1592, 6.2843, 1.0314}, {0.1504, 6.2892, 1.0370},
+                 {0.1468, 6.2880, 1.0185}, {0.1567, 6.2857, 1.0153}};
+  m.add_face({0, 1, 2, 3});
+  m.add_face({4, 5, 6, 7});
+  const EvalResult self = evaluate(m, m, small_params());
+  EXPECT_EQ(self.flipped_faces, 0u);
+  EXPECT_EQ(self.flipped_faces_kept, 1u);
+
+  PolyMesh moved = m;
+  moved.positions[0].x() += 1e-5;  // no longer the input face
+  const EvalResult r = evaluate(m, moved, small_params());
+  EXPECT_EQ(r.flipped_faces, 1u);
+  EXPECT_EQ(r.flipped_faces_kept, 0u);
+
+  // A rotated corner order is the same face.
+  PolyMesh rotated;
+  rotated.positions = m.positions;
+  rotated.add_face({2, 3, 0, 1});
+  rotated.add_face({4, 5, 6, 7});
+  EXPECT_EQ(evaluate(m, rotated, small_params()).flipped_faces_kept, 1u);
+}
+
 // ∫₀¹∫₀¹ sqrt(1 + s² + t²) ds dt: inner integral in closed form, outer by composite Simpson.
 double unit_square_mean_of_sqrt_1_s2_t2() {
   auto inner = [](double s) {  // ∫₀¹ sqrt(c² + t²) dt, c² = 1 + s²

@@ -28,6 +28,12 @@ void expect_valid(const PolyMesh& in, const PolyMesh& out, const std::string& wh
   EXPECT_LE(b.duplicate_faces, a.duplicate_faces) << what;
   EXPECT_EQ(b.nonfinite_vertices, 0u) << what;
   EXPECT_EQ(b.unused_vertices, 0u) << what;
+  // No face facing away from the input surface (docs/metrics.md §6b; the collapse's
+  // `orientation` refusal enforces eval's rule).
+  EvalParams ep;
+  ep.samples = 1000;
+  ep.curve_samples = 1000;
+  EXPECT_EQ(evaluate(in, out, ep).flipped_faces, 0u) << what;
 }
 
 SimplifyOptions quick(double ratio) {
@@ -78,7 +84,9 @@ TEST(Simplify, CubeStaysAValidClosedMesh) {
     expect_valid(cube, r.mesh, "cube " + std::to_string(ratio));
     // Within the band, or the miss is explained.
     const double dev = std::abs(double(r.achieved) - double(r.target)) / double(r.target);
-    if (dev > 0.03) EXPECT_FALSE(r.note.empty()) << ratio;
+    if (dev > 0.03) {
+      EXPECT_FALSE(r.note.empty()) << ratio;
+    }
     // Euler characteristic of a sphere.
     const Connectivity conn = build_connectivity(r.mesh);
     EXPECT_EQ(std::int64_t(r.mesh.num_vertices()) - std::int64_t(conn.num_edges) + std::int64_t(r.mesh.num_faces()), 2)
@@ -151,7 +159,9 @@ TEST(Simplify, LargeReductionsRunInPassesOfEqualRatio) {
     EXPECT_EQ(passes[i]["input_tri_equivalent"], passes[i - 1]["achieved"]);
   EXPECT_EQ(r.passes_used, static_cast<int>(passes.size()));
   const double dev = std::abs(double(r.achieved) - n) / n;
-  if (dev > 0.03) EXPECT_FALSE(r.note.empty());
+  if (dev > 0.03) {
+    EXPECT_FALSE(r.note.empty());
+  }
   expect_valid(torus, r.mesh, "torus 0.2");
   // One pass is the paper's single selection.
   SimplifyOptions one = quick(0.2);
@@ -218,7 +228,9 @@ TEST(SimplifyCorpus, SmallCorpusMeshesAreValidAndOnTarget) {
       ASSERT_TRUE(r.ok()) << name << ": " << r.error;
       expect_valid(in.mesh, r.mesh, std::string(name) + " " + std::to_string(ratio));
       const double dev = std::abs(double(r.achieved) - double(r.target)) / double(r.target);
-      if (dev > 0.03) EXPECT_FALSE(r.note.empty()) << name << " " << ratio;
+      if (dev > 0.03) {
+        EXPECT_FALSE(r.note.empty()) << name << " " << ratio;
+      }
       EXPECT_GT(r.quads, 0u) << name;
     }
   }

@@ -108,10 +108,11 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
                         num(r.feature_deviation_max), num(r.feature_deviation_mean),
                         (unsigned long long)r.feature_edges_in, (unsigned long long)r.feature_edges_out);
             std::printf("  output validity     %u non-manifold edges (input %u), %u degenerate, %u duplicate, "
-                        "%llu flipped faces\n",
+                        "%llu flipped faces (+%llu input faces kept as they were)\n",
                         validity.nonmanifold_edges, input_validity.nonmanifold_edges,
                         validity.degenerate_faces, validity.duplicate_faces,
-                        static_cast<unsigned long long>(r.flipped_faces));
+                        static_cast<unsigned long long>(r.flipped_faces),
+                        static_cast<unsigned long long>(r.flipped_faces_kept));
             return kExitOk;
           }};
 }

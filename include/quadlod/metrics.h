@@ -105,7 +105,13 @@ struct EvalResult {
   /// Output faces that face away from the input surface they lie on: the nearest input surface
   /// with the face's orientation (normals within 90°) is more than twice as far from the face's
   /// centroid as the nearest input surface, plus EvalParams::flip_tolerance (docs/metrics.md §6b).
+  /// Faces that are unchanged input faces (same corner positions in the same order) are not
+  /// replacements and are counted in flipped_faces_kept instead.
   std::uint64_t flipped_faces = 0;
+  /// Unchanged input faces the same rule flags: the input itself is like that there (e.g. a
+  /// folded quad whose fan triangles face away from its Newell normal). Input against itself:
+  /// flipped_faces = 0 and flipped_faces_kept = the input's own count.
+  std::uint64_t flipped_faces_kept = 0;
 
   // --- features, UVs, materials (issue 7; docs/metrics.md §6c) ------------------------------------
   /// UV islands of UV set 0 with non-zero 3D area (0 when the mesh has no UVs).

@@ -29,6 +29,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <numbers>
 #include <string_view>
 #include <thread>
@@ -791,13 +792,42 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
 
   // §6b orientation: an output face is flipped when the nearest input surface that faces its way
   // is more than twice as far (plus flip_tolerance) as the nearest input surface: coincident
-  // two-sided input and faces lying between two close sheets are not counted.
+  // two-sided input and faces lying between two close sheets are not counted. An output face
+  // that IS an input face (same corners, same positions, same order) replaces nothing: if the
+  // rule flags it, the input was already like that (folded quads whose fan triangles disagree
+  // with their Newell normal) and it is counted apart, in flipped_faces_kept.
   {
     std::vector<Vec3> normal_in(soup_in.triangles.size());
     for (std::size_t t = 0; t < soup_in.triangles.size(); ++t) {
       const auto& tri = soup_in.triangles[t];
       normal_in[t] = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
     }
+    // Built on the first flagged face only: input vertices as points, input faces by corner cycle.
+    SegmentBvh input_points;
+    std::set<std::vector<Index>> input_cycles;
+    auto canonical = [](std::vector<Index> cycle) {
+      std::rotate(cycle.begin(), std::min_element(cycle.begin(), cycle.end()), cycle.end());
+      return cycle;
+    };
+    auto is_input_face = [&](Index f) {
+      if (input_points.size() == 0) {
+        std::vector<std::array<Vec3, 2>> pts(in.positions.size());
+        for (std::size_t v = 0; v < pts.size(); ++v) pts[v] = {in.positions[v], in.positions[v]};
+        input_points = SegmentBvh(pts);
+        for (Index g = 0; g < in.num_faces(); ++g) {
+          const auto vs = in.face_vertices(g);
+          input_cycles.insert(canonical({vs.begin(), vs.end()}));
+        }
+      }
+      // Positions are normalised (longest side 1); 1e-9 absorbs the text round trip of 9 digits.
+      std::vector<Index> cycle;
+      for (Index v : out.face_vertices(f)) {
+        const NearestHit h = input_points.nearest(out.positions[v]);
+        if (h.primitive == kInvalidIndex || h.distance_sq > 1e-18) return false;
+        cycle.push_back(h.primitive);
+      }
+      return input_cycles.count(canonical(std::move(cycle))) > 0;
+    };
     for (Index f = 0; f < out.num_faces(); ++f) {
       const Vec3 n_out = face_area_vector(out, f);
       if (n_out.isZero(0.0)) continue;
@@ -807,7 +837,7 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
       const NearestHit agreeing = bvh_in.nearest_if(c, [&](Index t) { return normal_in[t].dot(n_out) >= 0.0; });
       if (agreeing.primitive == kInvalidIndex ||
           std::sqrt(agreeing.distance_sq) > 2.0 * std::sqrt(any.distance_sq) + params.flip_tolerance)
-        ++r.flipped_faces;
+        ++(is_input_face(f) ? r.flipped_faces_kept : r.flipped_faces);
     }
   }
 
@@ -941,6 +971,7 @@ nlohmann::json to_json(const EvalResult& r) {
   j["flow_deviation_p90_deg"] = num(r.flow_deviation_p90_deg);
   j["flow_coverage"] = num(r.flow_coverage);
   j["flipped_faces"] = r.flipped_faces;
+  j["flipped_faces_kept"] = r.flipped_faces_kept;
   j["uv_islands_in"] = r.uv_islands_in;
   j["uv_islands_out"] = r.uv_islands_out;
   j["seams_torn"] = r.seams_torn;

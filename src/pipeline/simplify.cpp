@@ -399,7 +399,13 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (n < n0 && n > 0.0)
     planned = std::clamp(static_cast<int>(std::ceil(std::log(n / n0) / std::log(options.pass_ratio) - 1e-9)), 1, max_passes);
   const double pass_time = options.time_limit_seconds / planned;
-  // Every pass measures feature_tolerance against the original input's strict lines.
+  // Every pass checks orientation against the original input surface (docs/metrics.md §6b) ...
+  std::optional<SurfaceReference> surface;
+  if (cp.check_surface_orientation) {
+    surface = make_surface_reference(input);
+    cp.surface_reference = &*surface;
+  }
+  // ... and measures feature_tolerance against the original input's strict lines.
   std::optional<FeatureReference> reference;
   if (options.features) {
     const Connectivity conn = build_connectivity(input);

@@ -19,6 +19,7 @@
 
 #include "geometry/bvh.h"
 #include "geometry/quadric.h"
+#include "geometry/sampling.h"
 #include "mesh/union_find.h"
 #include "util/progress.h"
 
@@ -101,6 +102,8 @@ class Collapser {
   void check_face(Index f);
   void check_vertex(Index v);
   void check_hausdorff(Index v);
+  template <class PositionOf>
+  bool faces_input_surface(Index len, PositionOf&& at, const Vec3& av) const;
   void gather_fan(Index v);
   void blame(Index r, CollapseRefusal why);
   void blame_piece(const Index* corners, Index len, CollapseRefusal why);
@@ -135,6 +138,9 @@ class Collapser {
   const FeatureEdges* feat_ptr_ = nullptr;
   FeatureReference own_reference_;
   const FeatureReference* reference_ = nullptr;
+  SurfaceReference own_surface_;
+  const SurfaceReference* surface_ = nullptr;
+  double orientation_tol_ = 0.0;  // absolute slack of the surface orientation check
 
   // Clusters. Every vertex has a root (the smallest member id of its cluster); a root's members
   // are member_list_[seg_begin_[r], seg_end_[r]), sorted ascending.
@@ -212,6 +218,14 @@ void Collapser::precompute() {
     face_n_[f] = face_area_[f] > 0.0 ? Vec3(av / face_area_[f]) : Vec3::Zero();
   }
   input_nm_.assign(nv_, -1);
+  if (params_.check_surface_orientation) {
+    surface_ = params_.surface_reference;
+    if (!surface_) {
+      own_surface_ = make_surface_reference(mesh_);
+      surface_ = &own_surface_;
+    }
+    orientation_tol_ = std::max(0.0, params_.orientation_tolerance) * surface_->longest_side;
+  }
   features_on_ = params_.respect_features;
   if (features_on_) {
     feat_ptr_ = params_.feature_edges;
@@ -745,6 +759,10 @@ void Collapser::check_face(Index f) {
       blame_piece(cs, len, CollapseRefusal::Flip);
       continue;
     }
+    if (surface_ && !faces_input_surface(len, at, av)) {
+      blame_piece(cs, len, CollapseRefusal::Orientation);
+      continue;
+    }
     if (!params_.check_corner_folds || len < 4) continue;
     for (Index i = 0; i < len; ++i) {
       const Vec3& prev = at(i == 0 ? len - 1 : i - 1);
@@ -764,6 +782,24 @@ void Collapser::check_face(Index f) {
       }
     }
   }
+}
+
+// docs/metrics.md §6b, as `quadlod eval` applies it to a finished output face: from the centroid of
+// the corners, the nearest input triangle facing the piece's way (area vectors with dot >= 0)
+// may be at most twice as far as the nearest input triangle of either orientation, plus the
+// tolerance. Over a fold, a piece that slid onto the sheet facing away fails it even when it
+// still agrees with its own input face.
+template <class PositionOf>
+bool Collapser::faces_input_surface(Index len, PositionOf&& at, const Vec3& av) const {
+  Vec3 c = Vec3::Zero();
+  for (Index i = 0; i < len; ++i) c += at(i);
+  c /= static_cast<double>(len);
+  const NearestHit any = surface_->bvh.nearest(c);
+  if (any.primitive == kInvalidIndex) return true;
+  const double reach = 2.0 * std::sqrt(any.distance_sq) + orientation_tol_;
+  const NearestHit agreeing = surface_->bvh.nearest_if(
+      c, [&](Index t) { return surface_->normal[t].dot(av) >= 0.0; }, kInvalidIndex, reach * reach);
+  return agreeing.primitive != kInvalidIndex && std::sqrt(agreeing.distance_sq) <= reach;
 }
 
 // The output faces around output vertex v (a root): the pieces, of the input faces around its
@@ -1386,6 +1422,20 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
 
 }  // namespace
 
+SurfaceReference make_surface_reference(const PolyMesh& mesh) {
+  SurfaceReference ref;
+  TriangleSoup soup = fan_triangulate(mesh);
+  ref.normal.resize(soup.triangles.size());
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+    const auto& tri = soup.triangles[t];
+    ref.normal[t] = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+  }
+  ref.bvh = TriangleBvh(soup.triangles);
+  const double side = bounding_box(mesh).longest_side();
+  ref.longest_side = side > 0.0 && std::isfinite(side) ? side : 1.0;
+  return ref;
+}
+
 FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat) {
   constexpr std::uint8_t kKinds[4] = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam, kFeatureMaterialBorder};
   FeatureReference ref;
@@ -1409,6 +1459,7 @@ const char* to_string(CollapseRefusal reason) {
     case CollapseRefusal::DegenerateFace: return "degenerate_face";
     case CollapseRefusal::Flip: return "flip";
     case CollapseRefusal::FoldedCorner: return "folded_corner";
+    case CollapseRefusal::Orientation: return "orientation";
     case CollapseRefusal::Hausdorff: return "hausdorff";
     case CollapseRefusal::Feature: return "feature";
   }

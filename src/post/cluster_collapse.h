@@ -13,8 +13,10 @@
 //      keep four distinct corners stay quads: nothing is ever triangulated.
 //   3. Guarantees, checked on the neighbourhood of every cluster: no new non-manifold edge or
 //      vertex, no new boundary edge, no degenerate (zero-area or repeated-index) face, no new
-//      duplicate face, no face flipped against the input face it comes from, no polygon folded
-//      over at a corner that was convex, and (optional) a bounded one-sided Hausdorff distance.
+//      duplicate face, no face flipped against the input face it comes from nor facing away from
+//      the nearest input surface (the rule `quadlod eval` counts flipped faces by), no polygon
+//      folded over at a corner that was convex, and (optional) a bounded one-sided Hausdorff
+//      distance.
 //      A cluster that breaks one is *refused*: it is split in two along its longest collapsed
 //      edges (or dissolved entirely after `max_bisect_rounds`), its refused edges become kept,
 //      and the check runs again on the faces that changed, until nothing is violated.
@@ -56,6 +58,17 @@ struct FeatureReference {
 };
 /// The strict edges of `mesh` (features from find_feature_edges on `conn`), sorted by kind.
 FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat);
+
+/// The original input surface, fan-triangulated as `quadlod eval` triangulates it, with each
+/// triangle's area vector: the reference of the orientation guarantee (docs/metrics.md §6b). A
+/// multi-pass reduction checks every pass against the original input, so an output face is
+/// never accepted facing away from the surface `eval` compares it with.
+struct SurfaceReference {
+  TriangleBvh bvh;
+  std::vector<Vec3> normal;  ///< area vector of each triangle of bvh (not normalised)
+  double longest_side = 1.0;  ///< of the input's bounding box (eval's unit of length)
+};
+SurfaceReference make_surface_reference(const PolyMesh& mesh);
 
 struct ClusterCollapseParams {
   // --- placement: the cluster quadric ---------------------------------------------------------
@@ -99,6 +112,19 @@ struct ClusterCollapseParams {
   /// An output face whose normal is more than this many degrees away from the normal of the
   /// input face it comes from is "flipped" (90 = any reversal of orientation). In (0, 180].
   double flip_angle_deg = 90.0;
+  /// Also refuse an output face that faces away from the input *surface* near it — the rule
+  /// `quadlod eval` counts `flipped_faces` by (docs/metrics.md §6b): the nearest input triangle
+  /// whose normal agrees with the face's (dot >= 0) must lie within twice the distance of the
+  /// nearest input triangle, plus orientation_tolerance × the input's longest bbox side, from
+  /// the face centroid. The check above compares with the face's own input face only, which
+  /// passes faces that slide over a fold onto a sheet facing the other way.
+  bool check_surface_orientation = true;
+  /// Half of EvalParams::flip_tolerance (1e-3), so an accepted face passes eval's count with a
+  /// margin for the rounding of eval's normalised copy.
+  double orientation_tolerance = 5e-4;
+  /// Surface the orientation check uses (borrowed; must outlive the call). nullptr: the mesh
+  /// being collapsed. simplify() passes the original input's in every pass.
+  const SurfaceReference* surface_reference = nullptr;
   /// Also refuse when a corner of an output polygon (>= 4 corners) turns reflex while the input
   /// corner was convex: the polygon folds over (bow-tie quads; concave quads, which fold when
   /// split along the wrong diagonal). Reflex = the interior angle, measured against the input
@@ -149,11 +175,12 @@ enum class CollapseRefusal : std::uint8_t {
   DegenerateFace,     ///< an output face with zero area
   Flip,               ///< an output face turned more than flip_angle_deg from its input face
   FoldedCorner,       ///< a convex polygon corner became reflex
+  Orientation,        ///< an output face faces away from the nearest input surface (§6b rule)
   Hausdorff,          ///< the placed vertex left the max_hausdorff band around the input
   Feature,            ///< the cluster joins two strict feature lines or two strict corners, or
                       ///< an output edge leaves the strict line it continues (feature_tolerance)
 };
-inline constexpr std::size_t kNumCollapseRefusals = 9;
+inline constexpr std::size_t kNumCollapseRefusals = 10;
 const char* to_string(CollapseRefusal reason);
 
 enum class ClusterCollapseStatus : std::uint8_t {
