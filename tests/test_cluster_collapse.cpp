@@ -735,5 +735,69 @@ TEST(ClusterCollapseFeatures, ChordCuttingACurvedBoundaryTooShortIsRefused) {
   EXPECT_EQ(l.mesh.num_faces(), 2u * (n - 1) - 6u);
 }
 
+// Two sheets meeting only at the ends A, B of a slit (flightgear_cg57_cruiser_hd: a wall standing
+// on a deck, each with its own boundary along their common line, sharing its two end vertices):
+//
+//      w0 ─── w1 ─── w2        wall, plane y = 0, UV = (x, z)
+//      │      │      │
+//      A ──── p1 ─── B         slit: the wall's boundary A–p1–B and the deck's A–q1–B coincide
+//      │        q1   │               (q1 at x = 1.2, p1 at x = 1)
+//      f0 ───── f1 ─ f2        deck, plane z = 0, UV = (x + 5, −y): another island
+//
+// Collapsing p1–B and q1–B shortens each boundary run along its own line (one strict corner, B;
+// features_valid accepts it), but both sheets then own an edge A–B: the slit is zipped shut into
+// a UV seam where the input had a boundary — a torn seam (metrics §6c). Refused as `feature`;
+// without feature handling the zip goes through.
+TEST(ClusterCollapseFeatures, ZippingASlitBetweenTwoSheetsIsRefused) {
+  PolyMesh in;
+  const Index A = in.add_vertex({0, 0, 0}), p1 = in.add_vertex({1, 0, 0}), B = in.add_vertex({2, 0, 0});
+  const Index w0 = in.add_vertex({0, 0, 1}), w1 = in.add_vertex({1, 0, 1}), w2 = in.add_vertex({2, 0, 1});
+  const Index q1 = in.add_vertex({1.2, 0, 0});
+  const Index f0 = in.add_vertex({0, -1, 0}), f1 = in.add_vertex({1.2, -1, 0}), f2 = in.add_vertex({2, -1, 0});
+  in.add_face({A, p1, w1, w0});
+  in.add_face({p1, B, w2, w1});
+  in.add_face({A, f0, f1, q1});
+  in.add_face({q1, f1, f2, B});
+  UvSet uv;
+  for (Index f = 0; f < in.num_faces(); ++f)
+    for (Index c = in.face_begin(f); c < in.face_end(f); ++c) {
+      const Vec3& p = in.positions[in.corner_vertex[c]];
+      uv.corner.push_back(static_cast<Index>(uv.values.size()));
+      uv.values.push_back(f < 2 ? Vec2(p.x(), p.z()) : Vec2(p.x() + 5.0, -p.y()));
+    }
+  in.uv_sets = {uv};
+  ASSERT_EQ(in.check_layout(), "");
+  const Connectivity conn = build_connectivity(in);
+  const auto kept = select(conn, {{p1, B}, {q1, B}});
+  // Output faces on the output edge between A and B (whichever vertices they became).
+  auto faces_on_AB = [](const ClusterCollapseResult& r) {
+    const Index a = r.vertex_map[0], b = r.vertex_map[2];
+    const Connectivity out = build_connectivity(r.mesh);
+    for (Index e = 0; e < out.num_edges; ++e) {
+      const auto [x, y] = out.edge_vertices[e];
+      if ((x == a && y == b) || (x == b && y == a)) return out.edge_face_count(e);
+    }
+    return Index{0};
+  };
+
+  ClusterCollapseParams plain;
+  plain.respect_features = false;
+  const ClusterCollapseResult z = collapse_clusters(in, conn, kept, plain);
+  ASSERT_EQ(z.status, ClusterCollapseStatus::Ok);
+  EXPECT_EQ(z.stats.total_refusals(), 0u);
+  EXPECT_EQ(faces_on_AB(z), 2u);  // zipped: one interior edge, a UV seam, from two boundaries
+  EXPECT_EQ(compute_stats(z.mesh, build_connectivity(z.mesh)).boundary_edges, 8u);
+
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.refusals(CollapseRefusal::Feature), 1u);
+  // The longer collapsed edge (p1–B, 1 against 0.8) is cut: the deck still collapses, the wall
+  // keeps its boundary run A–p1–B, and A–B is an edge of the deck alone.
+  EXPECT_NE(r.vertex_map[p1], r.vertex_map[B]);
+  EXPECT_EQ(r.vertex_map[q1], r.vertex_map[B]);
+  EXPECT_EQ(faces_on_AB(r), 1u);
+  EXPECT_EQ(compute_stats(r.mesh, build_connectivity(r.mesh)).boundary_edges, 11u);
+}
+
 }  // namespace
 }  // namespace quadlod

@@ -890,8 +890,13 @@ void Collapser::check_vertex(Index v) {
   bool all_two = nbr_.size() % 2 == 0;
   for (std::size_t i = 0; all_two && i < nbr_.size(); i += 2)
     all_two = nbr_[i].first == nbr_[i + 1].first && (i + 2 == nbr_.size() || nbr_[i + 2].first != nbr_[i].first);
+  // Also needed where a member lies on an open boundary: an output edge with two faces there may
+  // have zipped two boundary runs together (see the count == 2 case below).
+  bool boundary_member = false;
+  if (features_on_ && all_two)
+    for (Index m : members(v)) boundary_member = boundary_member || (feat_ptr_->vertex_bits[m] & kFeatureBoundary);
   pre_.clear();
-  if (!all_two) {
+  if (!all_two || boundary_member) {
     for (Index m : members(v))
       for (Index c : conn_.corners_at_vertex(m))
         for (Index ec : {c, conn_.corner_prev[c]}) {
@@ -929,6 +934,15 @@ void Collapser::check_vertex(Index v) {
     } else if (count == 2) {
       const Index a = find(nbr_[i].second), b = find(nbr_[i + 1].second);
       if (a != b) fan_parent_[a] = b;
+      // Two faces on an edge whose input edges between the two clusters include an open boundary
+      // edge: the boundary was zipped shut there, to another boundary run sharing both endpoints
+      // (a slit: two sheets whose coincident borders meet only at the slit's ends) or to itself.
+      // Each cluster only shortens one boundary line, so features_valid cannot see it; the output
+      // edge is then a seam (or smooth) where the input had a hole, which §6c counts as torn.
+      if (features_on_ && min_in == 1) {
+        blame(v, CollapseRefusal::Feature);
+        blame(w, CollapseRefusal::Feature);
+      }
     }
     i = j;
   }
