@@ -31,6 +31,7 @@ LABELS = {"quadlod": "quadlod", "blender-collapse": "Blender collapse"}
 COLUMNS = [
     "mesh", "ratio", "method", "status", "error", "target", "achieved", "achieved_rel_error",
     "seams_torn", "seam_edges_in", "seam_edges_out", "uv_islands_in", "uv_islands_out",
+    "uv_islands_vanished", "uv_islands_merged", "uv_islands_split",
     "uv_error_mean", "uv_error_max", "uv_samples", "material_border_error",
     "material_mismatch_fraction", "feature_deviation_max", "feature_deviation_mean",
     "hausdorff", "chamfer", "qpr",
@@ -157,7 +158,7 @@ def make_markdown(rows, ratios):
              "Both methods reduce each mesh to the same triangle-equivalent target; `quadlod eval` "
              "measures both (definitions: docs/metrics.md §6c). uv err = texture-space distance over "
              "the input island's UV diagonal; torn = output seam/boundary edges not on an input "
-             "seam/boundary; islands = UV islands with area (in → out); mat. border = distance of "
+             "seam/boundary; islands = UV islands with area (in → out; v/m/s = vanished, merged, split); mat. border = distance of "
              "output material borders to the input's (normalised units; – when none); hausdorff "
              "in units of the input's longest bbox side.", "",
              "## Averages per ratio", "",
@@ -185,19 +186,21 @@ def make_markdown(rows, ratios):
     lines += ["", "Averages are over the runs that succeeded (`runs`); achieved/target and islands "
               "out/in are means of per-mesh ratios.", "",
               "## Per mesh", "",
-              "| mesh | ratio | method | achieved / target | islands in → out | torn | uv err mean "
+              "| mesh | ratio | method | achieved / target | islands in → out | v/m/s | torn | uv err mean "
               "| uv err max | mat. border | hausdorff |",
-              "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+              "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         if r["status"] != "ok":
-            lines.append("| %s | %s | %s | failed: %s | | | | | | |" % (
+            lines.append("| %s | %s | %s | failed: %s | | | | | | | |" % (
                 r["mesh"], bench_run.ratio_label(r["ratio"]), LABELS[r["method"]],
                 (r.get("error") or "").replace("|", "/")[:120]))
             continue
-        lines.append("| %s | %s | %s | %s / %s | %s → %s | %s | %s | %s | %s | %s |" % (
+        lines.append("| %s | %s | %s | %s / %s | %s → %s | %s/%s/%s | %s | %s | %s | %s | %s |" % (
             r["mesh"], bench_run.ratio_label(r["ratio"]), LABELS[r["method"]],
             fmt_int(r.get("achieved")), fmt_int(r.get("target")),
             fmt_int(r.get("uv_islands_in")), fmt_int(r.get("uv_islands_out")),
+            fmt_int(r.get("uv_islands_vanished")), fmt_int(r.get("uv_islands_merged")),
+            fmt_int(r.get("uv_islands_split")),
             fmt_int(r.get("seams_torn")), sci(num(r.get("uv_error_mean"))),
             sci(num(r.get("uv_error_max"))), sci(num(r.get("material_border_error"))),
             sci(num(r.get("hausdorff")))))

@@ -95,8 +95,10 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
             std::printf("  hausdorff           %.4e\n", num(r.hausdorff));
             std::printf("  flow deviation      %.2f deg mean, %.2f deg p90, coverage %.3f\n",
                         num(r.flow_deviation_deg), num(r.flow_deviation_p90_deg), num(r.flow_coverage));
-            std::printf("  uv                  islands %llu -> %llu, %llu seams torn, error %.4e mean, %.4e max\n",
+            std::printf("  uv                  islands %llu -> %llu (%llu vanished, %llu merged, %llu split), %llu seams torn, error %.4e mean, %.4e max\n",
                         (unsigned long long)r.uv_islands_in, (unsigned long long)r.uv_islands_out,
+                        (unsigned long long)r.uv_islands_vanished, (unsigned long long)r.uv_islands_merged,
+                        (unsigned long long)r.uv_islands_split,
                         (unsigned long long)r.seams_torn, num(r.uv_error_mean), num(r.uv_error_max));
             if (std::isnan(r.material_mismatch_fraction))
               std::printf("  materials           none in either mesh\n");

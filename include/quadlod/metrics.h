@@ -117,6 +117,16 @@ struct EvalResult {
   /// UV islands of UV set 0 with non-zero 3D area (0 when the mesh has no UVs).
   std::uint64_t uv_islands_in = 0;
   std::uint64_t uv_islands_out = 0;
+  /// Island correspondence (both meshes with UVs; else 0): every output fan triangle of positive
+  /// area votes at its centroid for the input island it lies in (closest input point; the
+  /// UV-nearest of the islands nearly as close). Vanished: input islands with area that no output
+  /// triangle votes for (reduced away: allowed). Merged: output islands voting for two or more
+  /// input islands (two charts joined, or a face spanning a seam: never allowed). Split: input
+  /// islands two or more output islands vote for. Without merges,
+  /// uv_islands_out = uv_islands_in − vanished + (extra pieces of split islands).
+  std::uint64_t uv_islands_vanished = 0;
+  std::uint64_t uv_islands_merged = 0;
+  std::uint64_t uv_islands_split = 0;
   /// Output edges that are UV seams (any set) or open boundaries in the output and are not within
   /// feature_tolerance of an input edge of the same kind (see EvalParams::feature_tolerance).
   std::uint64_t seams_torn = 0;

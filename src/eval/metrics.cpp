@@ -57,6 +57,14 @@ constexpr double kTornAbsoluteSlack = 1e-9;
 /// sheets (d = 0) compete. At most this many islands are compared per sample.
 constexpr double kCoincidentSlack = 1e-9;
 constexpr int kMaxVoteCandidates = 4;
+/// §6c island matching: a point whose UV is farther than this fraction of its island's UV
+/// diagonal from the UV of its closest input point looks across a reduced seam; then up to
+/// kMaxMatchCandidates islands within reach compete by UV.
+constexpr double kMatchUvMismatch = 0.25;
+constexpr int kMaxMatchCandidates = 32;
+/// §6c island matching: UV distances this close are a tie (exactly coincident twin sheets with
+/// the same UVs give equal distances up to rounding).
+constexpr double kUvTie = 1e-9;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
@@ -431,6 +439,183 @@ Vec2 uv_at(const PolyMesh& m, const TriangleSoup& soup, const std::vector<Index>
   return uv;
 }
 
+/// §6c island correspondence: the input island a point p of the output (UV uv_out there) lies in.
+/// Its closest input point is on triangle t0; when other islands come within `bound` of p (at most
+/// `kCandidates` islands are compared), the one whose UV at its closest point is nearest uv_out
+/// wins (ties → the smaller island id). With a non-zero `facing` (the output face's normal),
+/// islands whose triangle there faces the same way win over those facing away first: the two
+/// sheets of a two-sided panel are coincident, often with the same UVs. tri_island: per input fan
+/// triangle, its island (kInvalidIndex for zero area or no UV).
+struct IslandVote {
+  Index island = kInvalidIndex;
+  double uv_distance = 0.0;  ///< |uv_out − UV at the closest point of `island`|
+  /// Islands exactly as good (same facing, UV distance within kUvTie): `island` and its twins.
+  std::array<Index, kMaxMatchCandidates> ties{};
+  int num_ties = 0;
+};
+template <int kCandidates>
+IslandVote vote_island(const PolyMesh& input, const TriangleSoup& soup_in, const std::vector<Index>& first_in,
+                       const std::vector<Index>& tri_island, const TriangleBvh& bvh_in, const Vec3& p,
+                       const Vec2& uv_out, Index t0, double bound, const Vec3& facing = Vec3::Zero()) {
+  static_assert(kCandidates <= kMaxMatchCandidates);
+  IslandVote v;
+  if (t0 == kInvalidIndex || tri_island[t0] == kInvalidIndex) return v;
+  auto away = [&](Index t) {
+    const auto& tri = soup_in.triangles[t];
+    return facing.dot((tri[1] - tri[0]).cross(tri[2] - tri[0])) < 0.0;
+  };
+  Index seen[kCandidates] = {tri_island[t0]};
+  bool seen_away[kCandidates] = {away(t0)};
+  const auto& tri = soup_in.triangles[t0];
+  double seen_uv[kCandidates] = {
+      (uv_at(input, soup_in, first_in, t0, closest_point_on_triangle(p, tri[0], tri[1], tri[2]).point) - uv_out).norm()};
+  int count = 1;
+  for (; count < kCandidates; ++count) {
+    const int c = count;
+    const NearestHit h = bvh_in.nearest_if(
+        p, [&](Index t) { return tri_island[t] != kInvalidIndex && std::find(seen, seen + c, tri_island[t]) == seen + c; },
+        kInvalidIndex, bound * bound);
+    if (h.primitive == kInvalidIndex) break;
+    seen[c] = tri_island[h.primitive];
+    seen_away[c] = away(h.primitive);
+    seen_uv[c] = (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv_out).norm();
+  }
+  int best = 0;
+  for (int c = 1; c < count; ++c)
+    if (seen_away[c] < seen_away[best] ||
+        (seen_away[c] == seen_away[best] &&
+         (seen_uv[c] < seen_uv[best] || (seen_uv[c] == seen_uv[best] && seen[c] < seen[best]))))
+      best = c;
+  v.island = seen[best];
+  v.uv_distance = seen_uv[best];
+  for (int c = 0; c < count; ++c)
+    if (seen_away[c] == seen_away[best] && seen_uv[c] <= seen_uv[best] + kUvTie) v.ties[v.num_ties++] = seen[c];
+  return v;
+}
+
+/// Per input fan triangle: the island (UV set 0) of its face, kInvalidIndex for zero area.
+std::vector<Index> triangle_islands(const TriangleSoup& soup_in, const MeshFeatures& fin) {
+  std::vector<Index> tri_island(soup_in.triangles.size(), kInvalidIndex);
+  for (std::size_t t = 0; t < tri_island.size(); ++t)
+    if (triangle_area(soup_in.triangles[t]) > 0.0) tri_island[t] = fin.islands.face_island[soup_in.face[t]];
+  return tri_island;
+}
+
+struct IslandMatch {
+  std::uint64_t vanished = 0, merged = 0, split = 0;
+};
+
+/// §6c uv_islands_vanished / _merged / _split: every output fan triangle of positive area on a
+/// face with UVs votes (vote_island) at its centroid for the input island it lies in. Every
+/// output face takes part, however small, so an island that survives as one sliver still counts.
+/// First the coincident islands compete, as for uv_error's votes (twin sheets, both sides of a
+/// seam); when the winner's UV there is off by more than kMatchUvMismatch of its UV diagonal, the
+/// point looks across a reduced seam from its own chart, and the islands within the closest
+/// distance plus the longest edge of the output face (the farthest a reduced seam can have moved
+/// across the point; the rule of uv_error's self-seams) compete by UV instead.
+IslandMatch match_islands(const PolyMesh& input, const PolyMesh& output, const PolyMesh& out,
+                          const MeshFeatures& fin, const MeshFeatures& fout, const TriangleSoup& soup_in,
+                          const TriangleSoup& soup_out, const TriangleBvh& bvh_in, unsigned threads) {
+  IslandMatch r;
+  std::vector<double> longest_edge(out.num_faces(), 0.0);
+  for (Index f = 0; f < out.num_faces(); ++f)
+    for (Index c = out.face_begin(f); c < out.face_end(f); ++c)
+      longest_edge[f] = std::max(longest_edge[f], (out.positions[out.corner_vertex[out.next_corner(f, c)]] -
+                                                   out.positions[out.corner_vertex[c]]).norm());
+  const std::vector<Index> tri_island = triangle_islands(soup_in, fin);
+  const std::vector<Index> first_in = first_triangles(soup_in, input.num_faces());
+  const std::vector<Index> first_out = first_triangles(soup_out, output.num_faces());
+  const std::size_t n = soup_out.triangles.size();
+  std::vector<IslandVote> vote(n);
+  std::vector<char> shows_chart(n, 0);
+  parallel_chunks(n, threads, [&](std::size_t begin, std::size_t end) {
+    Index hint = kInvalidIndex;
+    for (std::size_t t = begin; t < end; ++t) {
+      const auto& tri = soup_out.triangles[t];
+      if (fout.islands.face_island[soup_out.face[t]] == kInvalidIndex || !(triangle_area(tri) > 0.0)) continue;
+      const Vec3 c = (tri[0] + tri[1] + tri[2]) / 3.0;
+      const NearestHit h = bvh_in.nearest(c, hint);
+      if (h.primitive == kInvalidIndex) continue;
+      hint = h.primitive;
+      const Vec2 u0 = uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[0]);
+      const Vec2 u1 = uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[1]);
+      const Vec2 u2 = uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[2]);
+      const Vec2 e1 = u1 - u0, e2 = u2 - u0;
+      const bool no_chart = !(std::abs(e1.x() * e2.y() - e1.y() * e2.x()) > 0.0);
+      const Vec2 uv = (u0 + u1 + u2) / 3.0;
+      const Vec3 facing = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const double d = std::sqrt(h.distance_sq);
+      IslandVote v = vote_island<kMaxMatchCandidates>(input, soup_in, first_in, tri_island, bvh_in, c, uv, h.primitive,
+                                                     2.0 * d + kCoincidentSlack, facing);
+      if (v.island != kInvalidIndex &&
+          v.uv_distance > kMatchUvMismatch * (fin.islands.uv_max[v.island] - fin.islands.uv_min[v.island]).norm()) {
+        const double reach = d + longest_edge[soup_out.face[t]] + kCoincidentSlack;
+        v = vote_island<kMaxMatchCandidates>(input, soup_in, first_in, tri_island, bvh_in, c, uv, h.primitive, reach, facing);
+      }
+      vote[t] = v;
+      shows_chart[t] = !no_chart;
+    }
+  });
+  // Each output island's chart X: the input island most of its votes name (ties → smaller id).
+  // A vote that does not name X is a merge unless X explains the point as well: X lies within the
+  // point's reach and its UV there is within kMatchUvMismatch of X's UV diagonal (islands whose
+  // UVs continue each other across their seam, where a point near the seam can go either way).
+  std::vector<char> named(fin.islands.num_islands, 0);
+  std::vector<std::pair<Index, Index>> pairs;  // (output island, input island), one per vote and tie
+  for (std::size_t t = 0; t < n; ++t) {
+    if (vote[t].island == kInvalidIndex) continue;
+    for (int k = 0; k < vote[t].num_ties; ++k) named[vote[t].ties[k]] = 1;
+    // A triangle whose UVs have no area (all corners on one texel or line, as hard-surface models
+    // colour whole parts) shows no chart: it keeps its island from vanishing but decides nothing.
+    if (!shows_chart[t]) continue;
+    const Index o = fout.islands.face_island[soup_out.face[t]];
+    for (int k = 0; k < vote[t].num_ties; ++k) pairs.emplace_back(o, vote[t].ties[k]);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<Index> chart(fout.islands.num_islands, kInvalidIndex);
+  std::vector<std::size_t> most(fout.islands.num_islands, 0);
+  for (std::size_t a = 0, b; a < pairs.size(); a = b) {
+    for (b = a; b < pairs.size() && pairs[b] == pairs[a]; ++b) {}
+    if (b - a > most[pairs[a].first]) {
+      most[pairs[a].first] = b - a;
+      chart[pairs[a].first] = pairs[a].second;
+    }
+  }
+  std::vector<char> merged(fout.islands.num_islands, 0);
+  for (std::size_t t = 0; t < n; ++t) {  // serial: inconsistent votes are few
+    if (vote[t].island == kInvalidIndex || !shows_chart[t]) continue;
+    const Index o = fout.islands.face_island[soup_out.face[t]];
+    const Index x = chart[o];
+    if (merged[o] || std::find(vote[t].ties.begin(), vote[t].ties.begin() + vote[t].num_ties, x) !=
+                         vote[t].ties.begin() + vote[t].num_ties)
+      continue;
+    const auto& tri = soup_out.triangles[t];
+    const Vec3 c = (tri[0] + tri[1] + tri[2]) / 3.0;
+    const Vec2 uv = (uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[0]) +
+                     uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[1]) +
+                     uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[2])) / 3.0;
+    const double reach = std::sqrt(bvh_in.nearest(c).distance_sq) + longest_edge[soup_out.face[t]] + kCoincidentSlack;
+    const NearestHit h = bvh_in.nearest_if(c, [&](Index q) { return tri_island[q] == x; }, kInvalidIndex, reach * reach);
+    const bool explained = h.primitive != kInvalidIndex &&
+                           (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv).norm() <=
+                               kMatchUvMismatch * (fin.islands.uv_max[x] - fin.islands.uv_min[x]).norm();
+    if (!explained) merged[o] = 1;
+  }
+  // Split: input islands that are the chart of two or more output islands without a merge.
+  std::vector<Index> pieces(fin.islands.num_islands, 0);
+  for (Index o = 0; o < fout.islands.num_islands; ++o) {
+    if (chart[o] == kInvalidIndex) continue;
+    r.merged += merged[o];
+    if (!merged[o]) ++pieces[chart[o]];
+  }
+  for (Index i = 0; i < fin.islands.num_islands; ++i) {
+    if (!(fin.islands.area_3d[i] > 0.0)) continue;
+    r.vanished += !named[i];
+    r.split += pieces[i] >= 2;
+  }
+  return r;
+}
+
 struct UvErrorResult {
   double mean = kNaN, max = kNaN;
   std::uint64_t samples = 0;
@@ -447,9 +632,7 @@ UvErrorResult uv_error(const PolyMesh& input, const PolyMesh& output, const Poly
                        unsigned threads) {
   UvErrorResult r;
   const std::size_t n = s_out.points.size();
-  std::vector<Index> tri_island(soup_in.triangles.size(), kInvalidIndex);
-  for (std::size_t t = 0; t < tri_island.size(); ++t)
-    if (triangle_area(soup_in.triangles[t]) > 0.0) tri_island[t] = fin.islands.face_island[soup_in.face[t]];
+  const std::vector<Index> tri_island = triangle_islands(soup_in, fin);
   const std::vector<Index> first_in = first_triangles(soup_in, input.num_faces());
   const std::vector<Index> first_out = first_triangles(soup_out, output.num_faces());
   std::vector<Index> out_island(n, kInvalidIndex), vote(n, kInvalidIndex);
@@ -468,26 +651,10 @@ UvErrorResult uv_error(const PolyMesh& input, const PolyMesh& output, const Poly
       if (out_island[k] == kInvalidIndex || t0 == kInvalidIndex) continue;
       uv_out[k] = uv_at(output, soup_out, first_out, s_out.triangle[k], s_out.points[k]);
       if (tri_island[t0] == kInvalidIndex) continue;
-      const Vec3& p = s_out.points[k];
-      const double bound = 2.0 * d_out.dist[k] + kCoincidentSlack;
-      const auto& tri = soup_in.triangles[t0];
-      Index best = tri_island[t0];
-      double best_uv = (uv_at(input, soup_in, first_in, t0, closest_point_on_triangle(p, tri[0], tri[1], tri[2]).point) -
-                        uv_out[k]).squaredNorm();
-      Index seen[kMaxVoteCandidates] = {best};
-      for (int c = 1; c < kMaxVoteCandidates; ++c) {
-        const NearestHit h = bvh_in.nearest_if(
-            p, [&](Index t) { return tri_island[t] != kInvalidIndex && std::find(seen, seen + c, tri_island[t]) == seen + c; },
-            kInvalidIndex, bound * bound);
-        if (h.primitive == kInvalidIndex) break;
-        seen[c] = tri_island[h.primitive];
-        const double d_uv = (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv_out[k]).squaredNorm();
-        if (d_uv < best_uv || (d_uv == best_uv && seen[c] < best)) {
-          best_uv = d_uv;
-          best = seen[c];
-        }
-      }
-      vote[k] = best;
+      // Only coincident or nearly as close islands compete (within 2·d + kCoincidentSlack:
+      // coincident twin sheets, two-sided panels, both sides of a seam; see docs/metrics.md §6c).
+      vote[k] = vote_island<kMaxVoteCandidates>(input, soup_in, first_in, tri_island, bvh_in, s_out.points[k],
+                                                uv_out[k], t0, 2.0 * d_out.dist[k] + kCoincidentSlack).island;
     }
   });
   std::vector<std::pair<Index, Index>> votes;  // (output island, input island), tallied serially
@@ -621,6 +788,10 @@ void feature_metrics(const PolyMesh& input, const PolyMesh& output, const PolyMe
     r.uv_error_mean = u.mean;
     r.uv_error_max = u.max;
     r.uv_samples = u.samples;
+    const IslandMatch m = match_islands(input, output, out, fin, fout, soup_in, soup_out, bvh_in, threads);
+    r.uv_islands_vanished = m.vanished;
+    r.uv_islands_merged = m.merged;
+    r.uv_islands_split = m.split;
   }
 
   // Material borders, keyed by the unordered pair of names.
@@ -974,6 +1145,9 @@ nlohmann::json to_json(const EvalResult& r) {
   j["flipped_faces_kept"] = r.flipped_faces_kept;
   j["uv_islands_in"] = r.uv_islands_in;
   j["uv_islands_out"] = r.uv_islands_out;
+  j["uv_islands_vanished"] = r.uv_islands_vanished;
+  j["uv_islands_merged"] = r.uv_islands_merged;
+  j["uv_islands_split"] = r.uv_islands_split;
   j["seams_torn"] = r.seams_torn;
   j["seam_edges_in"] = r.seam_edges_in;
   j["seam_edges_out"] = r.seam_edges_out;
