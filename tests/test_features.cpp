@@ -273,8 +273,17 @@ TEST(Features, SmoothingGroupsAndNormalSeams) {
   Found f = features_of(g);
   EXPECT_EQ(bit_count(f.fe, kFeatureHardEdge), 1u);
   EXPECT_EQ(f.fe.edge_bits[grid_edge(f.conn, n, 2, 0, 2, 1)], kFeatureHardEdge);
-  g.face_smoothing = {0, 1, 1, 1};  // smoothing off on face 0: its inner edge is hard
+  g.face_smoothing = {0, 1, 1, 1};  // smoothing off on face 0: the flat | smooth edge is hard
   EXPECT_EQ(bit_count(features_of(g).fe, kFeatureHardEdge), 1u);
+  // Flat-shaded faces next to each other (s off on both): shading is per face on both sides, not
+  // a crease line; only the dihedral angle makes such an edge hard. An all-flat coplanar strip has
+  // no hard edge (else a faceted model could not be reduced at all: every edge a feature).
+  g.face_smoothing = {0, 0, 0, 0};
+  EXPECT_EQ(bit_count(features_of(g).fe, kFeatureHardEdge), 0u);
+  g.face_smoothing = {0, 0, 1, 1};
+  f = features_of(g);
+  EXPECT_EQ(bit_count(f.fe, kFeatureHardEdge), 1u);
+  EXPECT_EQ(f.fe.edge_bits[grid_edge(f.conn, n, 2, 0, 2, 1)], kFeatureHardEdge);
   FeatureParams no_groups;
   no_groups.smoothing_groups = false;
   EXPECT_EQ(bit_count(features_of(g, no_groups).fe, kFeatureHardEdge), 0u);

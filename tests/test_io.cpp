@@ -551,6 +551,52 @@ TEST(ObjWrite, FurtherUvSetsAreDroppedWithAWarning) {
   EXPECT_EQ(r.mesh.uv_sets[0].corner, m.uv_sets[0].corner);
 }
 
+// A face without a material (group, object) after one with: OBJ has no "none", usemtl holds until
+// the next one, so the writer ends the tag with Blender's `usemtl (null)` and the reader reads
+// "(null)" back as no tag. Without it the last face came back red.
+TEST(ObjWrite, FaceWithoutTagAfterATaggedFaceEndsTheTag) {
+  const ReadResult r = obj(std::string(kSquareVerts) +
+                           "f 1 2 3\no A\ng G\nusemtl red\nf 1 3 4\no (null)\ng (null)\nusemtl (null)\nf 2 3 4\n");
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.mesh.face_material, (std::vector<Index>{X, 0, X}));
+  EXPECT_EQ(r.mesh.face_group, (std::vector<Index>{X, 0, X}));
+  EXPECT_EQ(r.mesh.face_object, (std::vector<Index>{X, 0, X}));
+  EXPECT_EQ(r.mesh.material_names, (std::vector<std::string>{"red"}));
+  std::string out, error;
+  ASSERT_TRUE(io_detail::format_obj(r.mesh, {}, out, error)) << error;
+  EXPECT_NE(out.find("f 1 2 3\no A\ng G\nusemtl red\nf 1 3 4\no (null)\ng (null)\nusemtl (null)\nf 2 3 4\n"),
+            std::string::npos)
+      << out;
+  const ReadResult back = obj(out);
+  ASSERT_TRUE(back.ok()) << back.error;
+  EXPECT_EQ(mesh_difference(r.mesh, back.mesh), "");
+}
+
+// PLY and OFF have no per-face tags: writing them warns (the CLI prints warnings), one line per
+// kind; OFF also drops UVs, normals and colours with a warning. Nothing to drop: no warning.
+TEST(IoWrite, PlyAndOffWarnAboutWhatTheyDrop) {
+  PolyMesh m = quad_grid(2, 2);
+  m.material_names = {"red", "blue"};
+  m.face_material = {0, 0, 1, X};
+  m.face_smoothing = {0, 1, 1, 1};
+  TempDir dir;
+  const WriteResult ply = write_mesh(m, dir / "m.ply");
+  ASSERT_TRUE(ply.ok()) << ply.error;
+  ASSERT_EQ(ply.warnings.size(), 2u);
+  EXPECT_NE(ply.warnings[0].find("no per-face materials (usemtl); 2 on 3 face(s) dropped"), std::string::npos)
+      << ply.warnings[0];
+  EXPECT_NE(ply.warnings[1].find("smoothing groups"), std::string::npos) << ply.warnings[1];
+  const WriteResult off = write_mesh(m, dir / "m.off");
+  ASSERT_TRUE(off.ok()) << off.error;
+  ASSERT_EQ(off.warnings.size(), 3u);  // UVs, materials, smoothing groups
+  EXPECT_NE(off.warnings[0].find("OFF has no texture coordinates; 1 UV set(s) dropped"), std::string::npos)
+      << off.warnings[0];
+  PolyMesh bare = quad_grid(2, 2);
+  bare.uv_sets.clear();
+  EXPECT_TRUE(write_mesh(bare, dir / "b.ply").warnings.empty());
+  EXPECT_TRUE(write_mesh(bare, dir / "b.off").warnings.empty());
+}
+
 INSTANTIATE_TEST_SUITE_P(Encodings, PlyRoundTrip,
                          ::testing::Values(PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian,
                                            PlyEncoding::BinaryBigEndian),

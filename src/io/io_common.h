@@ -5,6 +5,7 @@
 
 #include "quadlod/io.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -67,6 +68,28 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
                 std::string& error);
 bool format_off(const PolyMesh& mesh, const WriteOptions& options, std::string& out,
                 std::string& error);
+
+/// Appends to `warnings` one line per per-face tag kind (materials, groups, objects, smoothing
+/// groups) that `mesh` carries and a format without tags (PLY, OFF) drops: issue 7's "no silent
+/// loss" — a reduced mesh written as PLY must not lose its material assignment unnoticed.
+inline void warn_dropped_tags(const PolyMesh& mesh, const std::filesystem::path& path, const char* format,
+                              std::vector<std::string>& warnings) {
+  const auto tagged = [](const std::vector<Index>& tags) {
+    return static_cast<std::size_t>(std::count_if(tags.begin(), tags.end(), [](Index t) { return t != kInvalidIndex; }));
+  };
+  const auto warn = [&](std::size_t faces, std::size_t names, const char* kind) {
+    if (faces == 0) return;
+    warnings.push_back(path.string() + ": " + format + " has no per-face " + kind + "; " + std::to_string(names) +
+                       " on " + std::to_string(faces) + " face(s) dropped (write OBJ to keep them)");
+  };
+  warn(tagged(mesh.face_material), mesh.material_names.size(), "materials (usemtl)");
+  warn(tagged(mesh.face_group), mesh.group_names.size(), "groups (g)");
+  warn(tagged(mesh.face_object), mesh.object_names.size(), "objects (o)");
+  std::vector<Index> groups(mesh.face_smoothing);
+  std::sort(groups.begin(), groups.end());
+  warn(mesh.face_smoothing.size(), static_cast<std::size_t>(std::unique(groups.begin(), groups.end()) - groups.begin()),
+       "smoothing groups (s; 'off' counts as one)");
+}
 
 /// Runs `format` and writes its result atomically to `path`; the shared tail of every writer.
 template <class Format>

@@ -24,9 +24,18 @@ using namespace io_detail;
 
 namespace {
 
+// OBJ cannot say "no material" (or group, object) for a face after one that has one: usemtl
+// holds until the next usemtl, and Blender 3.4's importer keeps the previous material even for an
+// empty `usemtl` (checked: `usemtl A`, face, `usemtl`, face → both faces A). Blender's own OBJ
+// exporter (io_scene_obj, export_obj.py) writes `usemtl (null)` for faces without a material, so
+// the writer does the same for all three tags and the reader reads "(null)" as no tag. Blender
+// imports `usemtl (null)` as a separate slot named "(null)": not the previous material.
+constexpr std::string_view kNullTag = "(null)";
+
 // A per-face name tag (o, g, usemtl). The name is interned when the first face after the
 // statement is read, so the name table lists names in order of first use by a face and a
 // name that no face uses never enters it; that is what makes the round trip exact.
+// The name kNullTag ends the tag: the faces after it have none (kInvalidIndex).
 struct NameTag {
   std::string pending;
   bool dirty = false;
@@ -40,9 +49,13 @@ struct NameTag {
   void apply(std::vector<std::string>& names, std::vector<Index>& per_face, Index face) {
     if (dirty) {
       dirty = false;
-      const auto [it, inserted] = ids.try_emplace(pending, static_cast<Index>(names.size()));
-      if (inserted) names.push_back(pending);
-      current = it->second;
+      if (pending == kNullTag) {
+        current = kInvalidIndex;
+      } else {
+        const auto [it, inserted] = ids.try_emplace(pending, static_cast<Index>(names.size()));
+        if (inserted) names.push_back(pending);
+        current = it->second;
+      }
     }
     if (current == kInvalidIndex) return;
     if (per_face.size() < face) per_face.resize(face, kInvalidIndex);  // first tagged face
@@ -176,6 +189,9 @@ bool ObjParser::run() {
     mesh_.uv_sets.push_back(std::move(uv_));
   }
   if (!mesh_.corner_normal.empty()) mesh_.corner_normal.resize(mesh_.num_corners(), kInvalidIndex);
+  // Faces after a tag was ended (kNullTag) have none.
+  for (std::vector<Index>* tags : {&mesh_.face_object, &mesh_.face_group, &mesh_.face_material})
+    if (!tags->empty()) tags->resize(mesh_.num_faces(), kInvalidIndex);
   return true;
 }
 
@@ -501,11 +517,12 @@ bool format_obj(const PolyMesh& mesh, const WriteOptions& options, std::string& 
                              Index f, Index& previous, const char* keyword) {
     if (tags.empty()) return;
     const Index t = tags[f];
-    if (t != previous && t != kInvalidIndex) {
+    if (t != previous) {  // previous starts as none: untagged leading faces need no statement
       out += keyword;
-      if (!names[t].empty()) {
+      const std::string_view name = t == kInvalidIndex ? kNullTag : std::string_view(names[t]);
+      if (!name.empty()) {
         out += ' ';
-        out += names[t];
+        out += name;
       }
       out += '\n';
     }

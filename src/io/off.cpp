@@ -7,6 +7,7 @@
 // nOFF (arbitrary dimension) and OFF BINARY are rejected by name.
 //
 // Writer: "OFF", counts, "x y z" lines with WriteOptions::precision digits, "k i0 ... ik-1".
+// Everything else (UVs, normals, colours, per-face tags) is dropped with a WriteResult warning.
 #include "io/io_common.h"
 
 #include <algorithm>
@@ -222,7 +223,17 @@ ReadResult read_off(const std::filesystem::path& path, const ReadOptions& option
 
 WriteResult write_off(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options) {
-  return format_and_write(mesh, path, options, format_off);
+  WriteResult r = format_and_write(mesh, path, options, format_off);
+  if (!r.ok()) return r;
+  // OFF holds positions and faces only.
+  if (mesh.has_uvs())
+    r.warnings.push_back(path.string() + ": OFF has no texture coordinates; " + std::to_string(mesh.uv_sets.size()) +
+                         " UV set(s) dropped (write OBJ or PLY to keep them)");
+  if (mesh.has_normals()) r.warnings.push_back(path.string() + ": OFF has no normals; dropped (write OBJ to keep them)");
+  if (!mesh.vertex_colors.empty())
+    r.warnings.push_back(path.string() + ": OFF as written here has no vertex colours; dropped (write OBJ or PLY to keep them)");
+  warn_dropped_tags(mesh, path, "OFF", r.warnings);
+  return r;
 }
 
 }  // namespace quadlod

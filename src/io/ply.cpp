@@ -16,7 +16,7 @@
 // UVs, `list uchar float texcoord` (then `texcoord1`, … for further UV sets; set names other
 // than these are not kept). A face whose corners all lack UVs gets an empty texcoord list,
 // a partial one gets NaN pairs for the missing corners, which the reader maps back to "no UV".
-// Tags (o, g, usemtl, s) have no PLY form and are not written.
+// Tags (o, g, usemtl, s) have no PLY form and are not written; the WriteResult warns per kind.
 #include "io/io_common.h"
 
 #include <algorithm>
@@ -720,7 +720,9 @@ ReadResult read_ply(const std::filesystem::path& path, const ReadOptions& option
 
 WriteResult write_ply(const PolyMesh& mesh, const std::filesystem::path& path,
                       const WriteOptions& options) {
-  return format_and_write(mesh, path, options, format_ply);
+  WriteResult r = format_and_write(mesh, path, options, format_ply);
+  if (r.ok()) warn_dropped_tags(mesh, path, "PLY", r.warnings);
+  return r;
 }
 
 }  // namespace quadlod

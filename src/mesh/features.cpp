@@ -117,10 +117,13 @@ FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
       if (mesh.has_normals() && seam_across(conn, mesh.normals, mesh.corner_normal, c0, c1))
         bits |= kFeatureNormalSeam;
       if (has_materials && !same_material(mesh, f0, f1)) bits |= kFeatureMaterialBorder;
-      if (use_smoothing) {
-        const Index s0 = mesh.face_smoothing[f0], s1 = mesh.face_smoothing[f1];
-        if (s0 == 0 || s1 == 0 || s0 != s1) bits |= kFeatureHardEdge;
-      }
+      // Smoothing groups (OBJ `s`): normals are shared within a group, so an edge between two
+      // groups is a crease. Group 0 (`s off`) is flat shading (Blender imports it as a face with
+      // use_smooth off, not as sharp edges): between a flat and a smooth face the shading breaks,
+      // but between two flat faces it is per face on both sides anyway — no crease line, and
+      // marking it would make every edge of a faceted model a feature. The dihedral rule below
+      // still catches real creases there.
+      if (use_smoothing && mesh.face_smoothing[f0] != mesh.face_smoothing[f1]) bits |= kFeatureHardEdge;
       // Dihedral angle = angle between the face normals, with the second normal reversed when the
       // faces are inconsistently oriented (else a flat but flipped pair would read as 180°).
       // A zero-area face has no normal and never makes a hard edge.

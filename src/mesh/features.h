@@ -9,7 +9,8 @@
 //   * normal seam — the per-corner normals differ across the edge in the same sense;
 //   * material border — the two faces have different `face_material`;
 //   * hard edge — dihedral angle >= hard_angle_deg, or (when smoothing groups are present) the
-//     faces lie in different smoothing groups or either has smoothing off (group 0).
+//     faces lie in different smoothing groups; smoothing off (group 0, flat shading) counts as a
+//     group of its own, so flat | smooth is hard and flat | flat only by its dihedral angle.
 // Only manifold interior edges can be seams, borders or hard edges; boundary and non-manifold
 // edges carry their own bit.
 //
