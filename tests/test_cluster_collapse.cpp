@@ -799,5 +799,40 @@ TEST(ClusterCollapseFeatures, ZippingASlitBetweenTwoSheetsIsRefused) {
   EXPECT_EQ(compute_stats(r.mesh, build_connectivity(r.mesh)).boundary_edges, 11u);
 }
 
+// A per-face UV layout (every face its own island: all seams non-strict, every vertex a feature
+// corner). Collapsing the chord of column 2 of a 6×4 grid merges x = 2/6 with x = 3/6: every
+// merged vertex lands on one of its two members (a half-edge collapse), never between them, so the
+// output's vertical edges are input edges and its horizontal ones run along input edges (two
+// collinear ones) — on the input seams. The plain quadric would put them at x = 2.5/6, off every
+// input edge.
+TEST(ClusterCollapseFeatures, PerFaceLayoutClustersLandOnAMemberCorner) {
+  const Index n = 6, m = 4;
+  PolyMesh in = make_grid(n, m);
+  UvSet& uv = in.uv_sets[0];
+  uv.values.clear();
+  for (Index f = 0; f < in.num_faces(); ++f)
+    for (Index c = in.face_begin(f); c < in.face_end(f); ++c) {
+      const Vec3& p = in.positions[in.corner_vertex[c]];
+      uv.corner[c] = static_cast<Index>(uv.values.size());
+      uv.values.push_back(Vec2(p.x() + 2.0 * double(f), p.y()));  // one island per face
+    }
+  const Connectivity conn = build_connectivity(in);
+  const FeatureEdges fe = find_feature_edges(in, conn);
+  for (Index e = 0; e < conn.num_edges; ++e) ASSERT_FALSE(fe.is_strict(e) && !conn.is_boundary_edge(e)) << e;
+  auto id = [&](Index i, Index j) { return j * (n + 1) + i; };
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, column_chord(n, m, 2)));
+  expect_valid_output(in, r);
+  // Rows 0 and m join two strict corners (boundary meets a seam at both members): refused.
+  EXPECT_EQ(r.stats.refusals(CollapseRefusal::Feature), 2u);
+  EXPECT_EQ(r.stats.total_refusals(), 2u);
+  for (Index j = 1; j < m; ++j) {
+    EXPECT_EQ(r.vertex_map[id(2, j)], r.vertex_map[id(3, j)]) << "row " << j;
+    const double x = r.mesh.positions[r.vertex_map[id(2, j)]].x();
+    EXPECT_TRUE(x == 2.0 / 6 || x == 3.0 / 6) << "row " << j << ": x = " << x;
+    EXPECT_EQ(r.mesh.positions[r.vertex_map[id(2, j)]].y(), double(j) / m);
+  }
+  EXPECT_GE(r.stats.placements_at_feature_corner, m - 1);
+}
+
 }  // namespace
 }  // namespace quadlod

@@ -212,7 +212,8 @@ struct ClusterCollapseStats {
   Index placements_volume_constrained = 0;  ///< clusters placed under the volume constraint
   Index placements_pseudo_inverse = 0;      ///< ill-conditioned systems solved by eigen cutoff
   Index placements_fallback = 0;            ///< minimiser untrusted: best of centroid/members
-  Index placements_at_feature_corner = 0;   ///< clusters placed at their one feature corner
+  Index placements_at_feature_corner = 0;   ///< clusters placed at a feature corner: their one, or
+                                            ///< the best of several per-face-layout seam corners
   Index placements_on_feature_line = 0;     ///< clusters placed on the feature segments around them
   // Attributes.
   Index uv_values_projected = 0;    ///< new UV values (wedges of moved vertices, all sets)
