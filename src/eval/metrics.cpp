@@ -549,8 +549,11 @@ IslandMatch match_islands(const PolyMesh& input, const PolyMesh& output, const P
                                                      2.0 * d + kCoincidentSlack, facing);
       if (v.island != kInvalidIndex &&
           v.uv_distance > kMatchUvMismatch * (fin.islands.uv_max[v.island] - fin.islands.uv_min[v.island]).norm()) {
+        // By UV alone: facing only separates coincident sheets; within reach, on a curved or
+        // folded surface, the right chart's closest triangle may well face another way
+        // (makehuman_teeth_base at 0.2: 3 false merges when facing decided here too).
         const double reach = d + longest_edge[soup_out.face[t]] + kCoincidentSlack;
-        v = vote_island<kMaxMatchCandidates>(input, soup_in, first_in, tri_island, bvh_in, c, uv, h.primitive, reach, facing);
+        v = vote_island<kMaxMatchCandidates>(input, soup_in, first_in, tri_island, bvh_in, c, uv, h.primitive, reach);
       }
       vote[t] = v;
       shows_chart[t] = !no_chart;

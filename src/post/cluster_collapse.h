@@ -22,10 +22,10 @@
 //      and the check runs again on the faces that changed, until nothing is violated.
 //      Every refusal is counted by reason together with the triangle-equivalents it kept.
 //   4. Feature lines (issue 7, src/mesh/features.h; docs/attributes.md): a cluster that touches a
-//      feature line is placed *on* it — at its feature corner if it has one, else at the minimiser
-//      of its quadric along the feature segments around it — and a cluster that would join two
-//      strict feature lines (boundaries, UV seams, material borders) or two strict corners is
-//      refused. The selection already avoids such clusters (feature_pinned_edges); this is the
+//      feature line is placed *on* it — at its feature corner if it has one (the best of its
+//      corners on a per-face UV layout), else at the minimiser of its quadric along the feature
+//      segments around it — and a cluster that would join two strict feature lines (boundaries,
+//      UV seams, material borders) or two strict corners, or zip a boundary shut, is refused. The selection already avoids such clusters (feature_pinned_edges); this is the
 //      guarantee behind it.
 //   5. Attributes per wedge: the UVs of a moved vertex are re-projected into the chart each of its
 //      corners came from (the input faces around the cluster joined across non-seam edges: one
@@ -178,7 +178,9 @@ enum class CollapseRefusal : std::uint8_t {
   Orientation,        ///< an output face faces away from the nearest input surface (§6b rule)
   Hausdorff,          ///< the placed vertex left the max_hausdorff band around the input
   Feature,            ///< the cluster joins two strict feature lines or two strict corners, or
-                      ///< an output edge leaves the strict line it continues (feature_tolerance)
+                      ///< an output edge leaves the strict line it continues (feature_tolerance),
+                      ///< or an output edge with two faces covers an input boundary edge (a
+                      ///< boundary zipped shut)
 };
 inline constexpr std::size_t kNumCollapseRefusals = 10;
 const char* to_string(CollapseRefusal reason);
