@@ -559,12 +559,15 @@ IslandMatch match_islands(const PolyMesh& input, const PolyMesh& output, const P
       shows_chart[t] = !no_chart;
     }
   });
-  // Each output island's chart X: the input island most of its votes name (ties → smaller id).
-  // A vote that does not name X is a merge unless X explains the point as well: X lies within the
-  // point's reach and its UV there is within kMatchUvMismatch of X's UV diagonal (islands whose
-  // UVs continue each other across their seam, where a point near the seam can go either way).
+  // Each output island's chart: an input island that every one of its votes names or that
+  // explains the vote's point as well — it lies within the point's reach and its UV there is
+  // within kMatchUvMismatch of its UV diagonal (islands whose UVs continue each other across their
+  // seam, or tiny neighbours in 3D and in the atlas, where a point can go either way). Candidates
+  // are the islands the output island's votes name, most named first (ties → smaller id); an
+  // output island that no candidate explains is merged.
   std::vector<char> named(fin.islands.num_islands, 0);
   std::vector<std::pair<Index, Index>> pairs;  // (output island, input island), one per vote and tie
+  std::vector<std::pair<Index, Index>> votes_by_island;  // (output island, output fan triangle)
   for (std::size_t t = 0; t < n; ++t) {
     if (vote[t].island == kInvalidIndex) continue;
     for (int k = 0; k < vote[t].num_ties; ++k) named[vote[t].ties[k]] = 1;
@@ -573,36 +576,55 @@ IslandMatch match_islands(const PolyMesh& input, const PolyMesh& output, const P
     if (!shows_chart[t]) continue;
     const Index o = fout.islands.face_island[soup_out.face[t]];
     for (int k = 0; k < vote[t].num_ties; ++k) pairs.emplace_back(o, vote[t].ties[k]);
+    votes_by_island.emplace_back(o, static_cast<Index>(t));
   }
   std::sort(pairs.begin(), pairs.end());
-  std::vector<Index> chart(fout.islands.num_islands, kInvalidIndex);
-  std::vector<std::size_t> most(fout.islands.num_islands, 0);
-  for (std::size_t a = 0, b; a < pairs.size(); a = b) {
-    for (b = a; b < pairs.size() && pairs[b] == pairs[a]; ++b) {}
-    if (b - a > most[pairs[a].first]) {
-      most[pairs[a].first] = b - a;
-      chart[pairs[a].first] = pairs[a].second;
-    }
-  }
-  std::vector<char> merged(fout.islands.num_islands, 0);
-  for (std::size_t t = 0; t < n; ++t) {  // serial: inconsistent votes are few
-    if (vote[t].island == kInvalidIndex || !shows_chart[t]) continue;
-    const Index o = fout.islands.face_island[soup_out.face[t]];
-    const Index x = chart[o];
-    if (merged[o] || std::find(vote[t].ties.begin(), vote[t].ties.begin() + vote[t].num_ties, x) !=
-                         vote[t].ties.begin() + vote[t].num_ties)
-      continue;
+  std::sort(votes_by_island.begin(), votes_by_island.end());
+  auto names = [&](Index t, Index x) {
+    return std::find(vote[t].ties.begin(), vote[t].ties.begin() + vote[t].num_ties, x) !=
+           vote[t].ties.begin() + vote[t].num_ties;
+  };
+  auto explains = [&](Index t, Index x) {
     const auto& tri = soup_out.triangles[t];
     const Vec3 c = (tri[0] + tri[1] + tri[2]) / 3.0;
-    const Vec2 uv = (uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[0]) +
-                     uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[1]) +
-                     uv_at(output, soup_out, first_out, static_cast<Index>(t), tri[2])) / 3.0;
+    const Vec2 uv = (uv_at(output, soup_out, first_out, t, tri[0]) + uv_at(output, soup_out, first_out, t, tri[1]) +
+                     uv_at(output, soup_out, first_out, t, tri[2])) / 3.0;
     const double reach = std::sqrt(bvh_in.nearest(c).distance_sq) + longest_edge[soup_out.face[t]] + kCoincidentSlack;
     const NearestHit h = bvh_in.nearest_if(c, [&](Index q) { return tri_island[q] == x; }, kInvalidIndex, reach * reach);
-    const bool explained = h.primitive != kInvalidIndex &&
-                           (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv).norm() <=
-                               kMatchUvMismatch * (fin.islands.uv_max[x] - fin.islands.uv_min[x]).norm();
-    if (!explained) merged[o] = 1;
+    return h.primitive != kInvalidIndex && (uv_at(input, soup_in, first_in, h.primitive, h.point) - uv).norm() <=
+                                               kMatchUvMismatch * (fin.islands.uv_max[x] - fin.islands.uv_min[x]).norm();
+  };
+  std::vector<Index> chart(fout.islands.num_islands, kInvalidIndex);
+  std::vector<char> merged(fout.islands.num_islands, 0);
+  std::vector<std::pair<std::size_t, Index>> candidates;  // (−count, island)
+  for (std::size_t a = 0, b, v0 = 0; a < pairs.size(); a = b) {  // serial: few islands disagree
+    const Index o = pairs[a].first;
+    candidates.clear();
+    for (b = a; b < pairs.size() && pairs[b].first == o;) {
+      std::size_t e = b;
+      while (e < pairs.size() && pairs[e] == pairs[b]) ++e;
+      candidates.emplace_back(std::numeric_limits<std::size_t>::max() - (e - b), pairs[b].second);
+      b = e;
+    }
+    std::sort(candidates.begin(), candidates.end());
+    while (v0 < votes_by_island.size() && votes_by_island[v0].first < o) ++v0;
+    std::size_t v1 = v0;
+    while (v1 < votes_by_island.size() && votes_by_island[v1].first == o) ++v1;
+    for (const auto& [minus_count, x] : candidates) {
+      bool all = true;
+      for (std::size_t k = v0; k < v1 && all; ++k) {
+        const Index t = votes_by_island[k].second;
+        all = names(t, x) || explains(t, x);
+      }
+      if (all) {
+        chart[o] = x;
+        break;
+      }
+    }
+    if (chart[o] == kInvalidIndex) {
+      merged[o] = 1;
+      chart[o] = candidates.front().second;
+    }
   }
   // Split: input islands that are the chart of two or more output islands without a merge.
   std::vector<Index> pieces(fin.islands.num_islands, 0);
