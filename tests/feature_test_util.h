@@ -26,6 +26,23 @@ inline PolyMesh grid_with_seam_column(Index n, Index m, Index split, double shif
   return g;
 }
 
+/// make_grid(n, m) with its own UV pool entry per corner: UV = position + (shift(face), 0). Faces
+/// with equal shifts that share an edge are one island (equal values are not a seam); edges
+/// between different shifts are seams.
+template <class Shift>
+PolyMesh grid_with_face_uvs(Index n, Index m, Shift&& shift) {
+  PolyMesh g = make_grid(n, m);
+  UvSet& uv = g.uv_sets[0];
+  uv.values.clear();
+  for (Index f = 0; f < g.num_faces(); ++f)
+    for (Index c = g.face_begin(f); c < g.face_end(f); ++c) {
+      const Vec3& p = g.positions[g.corner_vertex[c]];
+      uv.corner[c] = static_cast<Index>(uv.values.size());
+      uv.values.push_back(Vec2(p.x() + shift(f), p.y()));
+    }
+  return g;
+}
+
 /// Sets the material of every face of a make_grid(n, ·) mesh from its column:
 /// names[column_material[i]] for column i.
 inline void paint_columns(PolyMesh& g, Index n, std::vector<std::string> names,

@@ -807,15 +807,7 @@ TEST(ClusterCollapseFeatures, ZippingASlitBetweenTwoSheetsIsRefused) {
 // input edge.
 TEST(ClusterCollapseFeatures, PerFaceLayoutClustersLandOnAMemberCorner) {
   const Index n = 6, m = 4;
-  PolyMesh in = make_grid(n, m);
-  UvSet& uv = in.uv_sets[0];
-  uv.values.clear();
-  for (Index f = 0; f < in.num_faces(); ++f)
-    for (Index c = in.face_begin(f); c < in.face_end(f); ++c) {
-      const Vec3& p = in.positions[in.corner_vertex[c]];
-      uv.corner[c] = static_cast<Index>(uv.values.size());
-      uv.values.push_back(Vec2(p.x() + 2.0 * double(f), p.y()));  // one island per face
-    }
+  const PolyMesh in = feature_test::grid_with_face_uvs(n, m, [](Index f) { return 2.0 * double(f); });
   const Connectivity conn = build_connectivity(in);
   const FeatureEdges fe = find_feature_edges(in, conn);
   for (Index e = 0; e < conn.num_edges; ++e) ASSERT_FALSE(fe.is_strict(e) && !conn.is_boundary_edge(e)) << e;

@@ -645,20 +645,10 @@ TEST(EvalFeatures, UvOffsetIsTheOffsetOverTheIslandDiagonal) {
   EXPECT_EQ(none.uv_samples, 0u);
 }
 
-/// make_grid(n, m) with its own UV pool entry per corner: UV = position + (shift[i], 0) for the
-/// faces of column i, so columns with equal shifts form one UV island (equal values are not a
-/// seam) and the lines between different ones are seams.
+/// feature_test::grid_with_face_uvs with shift[i] for the faces of column i: columns with equal
+/// shifts form one UV island, the lines between different ones are seams.
 PolyMesh grid_with_column_islands(Index n, Index m, const std::vector<double>& shift) {
-  PolyMesh g = make_grid(n, m);
-  UvSet& uv = g.uv_sets[0];
-  uv.values.clear();
-  for (Index f = 0; f < g.num_faces(); ++f)
-    for (Index c = g.face_begin(f); c < g.face_end(f); ++c) {
-      const Vec3& p = g.positions[g.corner_vertex[c]];
-      uv.corner[c] = static_cast<Index>(uv.values.size());
-      uv.values.push_back(Vec2(p.x() + shift[f % n], p.y()));
-    }
-  return g;
+  return feature_test::grid_with_face_uvs(n, m, [&](Index f) { return shift[f % n]; });
 }
 
 /// The faces of `m` for which keep(face) holds, with all of m's vertices and pools.
@@ -688,44 +678,37 @@ PolyMesh stitch_left_of_column(PolyMesh g, Index n, Index i, double left_shift) 
   return g;
 }
 
+/// The island counts of an evaluation: in, out, vanished, merged, split.
+void expect_islands(const EvalResult& r, std::uint64_t in, std::uint64_t out, std::uint64_t vanished,
+                    std::uint64_t merged, std::uint64_t split) {
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.uv_islands_in, in);
+  EXPECT_EQ(r.uv_islands_out, out);
+  EXPECT_EQ(r.uv_islands_vanished, vanished);
+  EXPECT_EQ(r.uv_islands_merged, merged);
+  EXPECT_EQ(r.uv_islands_split, split);
+}
+
 // Island correspondence (uv_islands_vanished / _merged / _split) on known cases: a 6×2 grid
 // whose column pairs are three islands A | B | C (UV shifts 0, 3, 6).
 TEST(EvalFeatures, IslandsVanishMergeAndSplitKnownAnswers) {
   const Index n = 6, m = 2;
   const PolyMesh in = grid_with_column_islands(n, m, {0, 0, 3, 3, 6, 6});
-  const EvalResult same = evaluate(in, in, small_params());
-  ASSERT_TRUE(same.ok()) << same.error;
-  EXPECT_EQ(same.uv_islands_in, 3u);
-  EXPECT_EQ(same.uv_islands_out, 3u);
-  EXPECT_EQ(same.uv_islands_vanished, 0u);
-  EXPECT_EQ(same.uv_islands_merged, 0u);
-  EXPECT_EQ(same.uv_islands_split, 0u);
+  expect_islands(evaluate(in, in, small_params()), 3, 3, 0, 0, 0);
 
   // C's faces removed: C vanished, nothing merged; out = in − vanished.
-  const EvalResult gone = evaluate(in, keep_faces(in, [&](Index f) { return f % n < 4; }), small_params());
-  ASSERT_TRUE(gone.ok()) << gone.error;
-  EXPECT_EQ(gone.uv_islands_out, 2u);
-  EXPECT_EQ(gone.uv_islands_vanished, 1u);
-  EXPECT_EQ(gone.uv_islands_merged, 0u);
-  EXPECT_EQ(gone.uv_islands_split, 0u);
+  expect_islands(evaluate(in, keep_faces(in, [&](Index f) { return f % n < 4; }), small_params()), 3, 2, 1, 0, 0);
 
   // The seam B | C stitched shut (column 4's left corners take B's UVs): B and C are one output
   // island whose faces lie in, and carry the UVs of, both: one merge, and out = in − vanished − 1
   // shows it. seams_torn cannot: a merge adds no seam.
   const EvalResult joined = evaluate(in, stitch_left_of_column(in, n, 4, 3.0), small_params());
-  EXPECT_EQ(joined.uv_islands_out, 2u);
-  EXPECT_EQ(joined.uv_islands_vanished, 0u);
-  EXPECT_EQ(joined.uv_islands_merged, 1u);
-  EXPECT_EQ(joined.uv_islands_split, 0u);
+  expect_islands(joined, 3, 2, 0, 1, 0);
   EXPECT_EQ(joined.seams_torn, 0u);
 
   // B cut in two by a new seam (column 3's UVs moved by 0.1, still nearest B's chart): split,
   // not merged.
-  const EvalResult cut = evaluate(in, grid_with_column_islands(n, m, {0, 0, 3, 3.1, 6, 6}), small_params());
-  EXPECT_EQ(cut.uv_islands_out, 4u);
-  EXPECT_EQ(cut.uv_islands_vanished, 0u);
-  EXPECT_EQ(cut.uv_islands_merged, 0u);
-  EXPECT_EQ(cut.uv_islands_split, 1u);
+  expect_islands(evaluate(in, grid_with_column_islands(n, m, {0, 0, 3, 3.1, 6, 6}), small_params()), 3, 4, 0, 0, 1);
 }
 
 // Faces whose UVs span two islands (what an unconstrained collapse makes): input 4×1 grid with
@@ -741,12 +724,7 @@ TEST(EvalFeatures, FaceAcrossASeamIsAMerge) {
     if (p.x() > 0.5) out.uv_sets[0].values[out.uv_sets[0].corner[c]].x() += 3.0;
   }
   const EvalResult r = evaluate(in, out, small_params());
-  ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_EQ(r.uv_islands_in, 2u);
-  EXPECT_EQ(r.uv_islands_out, 1u);
-  EXPECT_EQ(r.uv_islands_merged, 1u);
-  EXPECT_EQ(r.uv_islands_vanished, 0u);
-  EXPECT_EQ(r.uv_islands_split, 0u);
+  expect_islands(r, 2, 1, 0, 1, 0);
   const nlohmann::json j = to_json(r);
   EXPECT_EQ(j["uv_islands_merged"], 1);
   EXPECT_EQ(j["uv_islands_vanished"], 0);
