@@ -432,7 +432,9 @@ void expect_same_after_ply(const PolyMesh& a, const PolyMesh& b) {
   for (Index c = 0; c < a.num_corners(); ++c) {
     const Index ta = a.uv_sets[0].corner[c], tb = b.uv_sets[0].corner[c];
     ASSERT_EQ(ta == kInvalidIndex, tb == kInvalidIndex) << "corner " << c;
-    if (ta != kInvalidIndex) EXPECT_TRUE(float_equal(a.uv_sets[0].values[ta], b.uv_sets[0].values[tb])) << "corner " << c;
+    if (ta != kInvalidIndex) {
+      EXPECT_TRUE(float_equal(a.uv_sets[0].values[ta], b.uv_sets[0].values[tb])) << "corner " << c;
+    }
   }
   ASSERT_TRUE(b.has_normals());
   EXPECT_EQ(b.corner_normal, b.corner_vertex);
@@ -532,8 +534,9 @@ TEST_P(PlyRoundTrip, SeveralUvSetsSurvive) {
     for (Index c = 0; c < m.num_corners(); ++c) {
       const Index ta = m.uv_sets[k].corner[c], tb = r.mesh.uv_sets[k].corner[c];
       ASSERT_EQ(ta == kInvalidIndex, tb == kInvalidIndex) << "set " << k << " corner " << c;
-      if (ta != kInvalidIndex)
+      if (ta != kInvalidIndex) {
         EXPECT_TRUE(float_equal(m.uv_sets[k].values[ta], r.mesh.uv_sets[k].values[tb])) << "set " << k << " corner " << c;
+      }
     }
 }
 
