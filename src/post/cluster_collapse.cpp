@@ -773,7 +773,13 @@ void Collapser::check_face(Index f) {
     auto at = [&](Index i) -> const Vec3& { return pos_[root_of_corner(cs[i])]; };
     const Vec3 av = area_vector(len, at);
     const double area = av.norm();
-    if (input_flat) continue;  // no reference normal; a degenerate input face is not ours to fix
+    if (input_flat) {
+      // No reference normal and a degenerate input face is not ours to fix, but what it turns
+      // into must still face the input surface (that rule needs no source normal).
+      if (area > zero_area_ && surface_ && !faces_input_surface(len, at, av))
+        blame_piece(cs, len, CollapseRefusal::Orientation);
+      continue;
+    }
     if (!(area > zero_area_)) {
       blame_piece(cs, len, CollapseRefusal::DegenerateFace);
       continue;
@@ -812,6 +818,8 @@ void Collapser::check_face(Index f) {
 // may be at most twice as far as the nearest input triangle of either orientation, plus the
 // tolerance. Over a fold, a piece that slid onto the sheet facing away fails it even when it
 // still agrees with its own input face.
+constexpr double kAgreeCos = 1e-3;  // cos 89.94°
+
 template <class PositionOf>
 bool Collapser::faces_input_surface(Index len, PositionOf&& at, const Vec3& av) const {
   Vec3 c = Vec3::Zero();
@@ -820,8 +828,12 @@ bool Collapser::faces_input_surface(Index len, PositionOf&& at, const Vec3& av) 
   const NearestHit any = surface_->bvh.nearest(c);
   if (any.primitive == kInvalidIndex) return true;
   const double reach = 2.0 * std::sqrt(any.distance_sq) + orientation_tol_;
+  // Stricter than eval's dot >= 0: a triangle within kAgreeCos of perpendicular, or of zero area,
+  // does not count as agreeing here, so rounding (eval reads the output back from 9-digit text
+  // and works on a rescaled copy) cannot make eval find an agreeing triangle farther away.
+  const double min_dot = kAgreeCos * av.norm();
   const NearestHit agreeing = surface_->bvh.nearest_if(
-      c, [&](Index t) { return surface_->normal[t].dot(av) >= 0.0; }, kInvalidIndex, reach * reach);
+      c, [&](Index t) { return surface_->normal[t].dot(av) >= min_dot; }, kInvalidIndex, reach * reach);
   return agreeing.primitive != kInvalidIndex && std::sqrt(agreeing.distance_sq) <= reach;
 }
 
@@ -1465,7 +1477,9 @@ SurfaceReference make_surface_reference(const PolyMesh& mesh) {
   ref.normal.resize(soup.triangles.size());
   for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
     const auto& tri = soup.triangles[t];
-    ref.normal[t] = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    const Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    const double len = n.norm();
+    ref.normal[t] = len > 0.0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
   }
   ref.bvh = TriangleBvh(soup.triangles);
   const double side = bounding_box(mesh).longest_side();

@@ -60,12 +60,12 @@ struct FeatureReference {
 FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat);
 
 /// The original input surface, fan-triangulated as `quadlod eval` triangulates it, with each
-/// triangle's area vector: the reference of the orientation guarantee (docs/metrics.md §6b). A
+/// triangle's unit normal: the reference of the orientation guarantee (docs/metrics.md §6b). A
 /// multi-pass reduction checks every pass against the original input, so an output face is
 /// never accepted facing away from the surface `eval` compares it with.
 struct SurfaceReference {
   TriangleBvh bvh;
-  std::vector<Vec3> normal;  ///< area vector of each triangle of bvh (not normalised)
+  std::vector<Vec3> normal;  ///< unit normal of each triangle of bvh (zero for zero area)
   double longest_side = 1.0;  ///< of the input's bounding box (eval's unit of length)
 };
 SurfaceReference make_surface_reference(const PolyMesh& mesh);
