@@ -217,6 +217,20 @@ TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {
 }
 
 #ifdef QUADLOD_CORPUS_DIR
+// Rounds that undo (docs/formulation.md "Rounds"): each may only undo collapses of the closest
+// round below N so far, so its count is never below that round's.
+void expect_undoing_rounds_only_restore(const nlohmann::json& pass_report, std::int64_t target, const std::string& what) {
+  std::int64_t below = -1;
+  for (const auto& round : pass_report["rounds"]) {
+    const std::int64_t achieved = round["achieved"];
+    if (round.value("undoing", false)) {
+      EXPECT_GE(below, 0) << what << ": undoing without a round below N";
+      EXPECT_GE(achieved, below) << what << " round " << round["round"];
+    }
+    if (achieved < target) below = std::max(below, achieved);
+  }
+}
+
 TEST(SimplifyCorpus, SmallCorpusMeshesAreValidAndOnTarget) {
   const std::filesystem::path dir = QUADLOD_CORPUS_DIR;
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not present";
@@ -232,6 +246,13 @@ TEST(SimplifyCorpus, SmallCorpusMeshesAreValidAndOnTarget) {
         EXPECT_FALSE(r.note.empty()) << name << " " << ratio;
       }
       EXPECT_GT(r.quads, 0u) << name;
+      const std::string what = std::string(name) + " " + std::to_string(ratio);
+      if (r.report.contains("passes")) {
+        for (const auto& pass : r.report["passes"])
+          expect_undoing_rounds_only_restore(pass["report"], pass["target"], what);
+      } else {
+        expect_undoing_rounds_only_restore(r.report, std::int64_t(r.target), what);
+      }
     }
   }
 }

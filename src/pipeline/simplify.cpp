@@ -220,10 +220,27 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   std::optional<ClusterCollapseResult> best;
   double best_distance = INFINITY;
   nlohmann::json rounds = nlohmann::json::array();
-  for (int round = 1; round <= max_rounds; ++round) {
-    const std::string tag = (round == 1 ? std::string() : " (round " + std::to_string(round) + ")") + pass_tag;
+  // Undershoot (beyond the paper): once a round removed too much, the rounds after it may only
+  // *undo* collapses of the closest such round — every edge it did not collapse is kept — so the
+  // next collapse is a subset of one already found valid, refuses little, and the count moves
+  // up toward N instead of jumping around it (blender_suzanne at 0.6: rounds 672, 644, 492, 523
+  // for N = 581). Up to `kTrimRounds` such rounds are added to max_rounds (none with
+  // --max-rounds 1, the paper's single round).
+  constexpr int kTrimRounds = 2;
+  std::vector<std::uint8_t> trim_keep;   // kept in the closest round below N, while undoing
+  std::vector<std::uint8_t> below_keep;  // kept in the closest round below N so far
+  double below_distance = INFINITY;
+  int round_limit = max_rounds;
+  for (int round = 1; round <= round_limit; ++round) {
+    const bool trimming = !trim_keep.empty();
+    const std::string tag = (round == 1 ? std::string() : " (round " + std::to_string(round) + (trimming ? ", undoing" : "") + ")") + pass_tag;
     sp.solve.time_limit_seconds = round == 1 ? time_limit : time_limit * options.later_round_time_fraction;
     sp.keep_edges = pinned;
+    if (trimming)
+      for (Index e = 0; e < conn.num_edges; ++e) sp.keep_edges[e] |= trim_keep[e];
+    // Undoing decides edge by edge (no Eq. 4): refusals bisected clusters of the round undone,
+    // so its collapsed edges are parts of segments, which Eq. 4 would keep whole — and lose.
+    sp.consistency = options.consistency && !trimming;
     clock = Stopwatch();
     const SelectionResult selection =
         select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
@@ -255,6 +272,12 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
              std::to_string(collapsed.stats.total_refusals()) + " clusters refused, " +
                  std::to_string(achieved) + " of " + std::to_string(target) + tag);
 
+    if (drift < 0 && max_rounds > 1 && double(-drift) < below_distance) {
+      below_distance = double(-drift);
+      below_keep.assign(conn.num_edges, 0);
+      for (Index e = 0; e < conn.num_edges; ++e) below_keep[e] = collapsed.edge_collapsed_final[e] ? 0 : 1;
+    }
+
     // Edges the selection (after repair) collapsed and the collapse kept: refused.
     Index newly_pinned = 0;
     if (pinned.empty()) pinned.assign(conn.num_edges, 0);
@@ -273,6 +296,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"refused_tri_equivalents",
          std::int64_t(collapsed.stats.tri_equivalent_out) - std::int64_t(collapsed.stats.tri_equivalent_wanted)},
         {"newly_pinned_edges", newly_pinned},
+        {"undoing", trimming},
         {"seconds_select", select_seconds},
         {"time_limit_seconds", sp.solve.time_limit_seconds},
     };
@@ -309,11 +333,21 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     }
     rounds.push_back(std::move(round_json));
     if (!reducing || distance <= options.round_tolerance * double(target)) break;
+    if (!below_keep.empty()) {
+      const bool first = trim_keep.empty();
+      trim_keep = below_keep;
+      if (first) {
+        round_limit = std::max(round_limit, round) + kTrimRounds;
+        previous_target = 0;  // a new function of the selection target: no secant across
+        selection_target = static_cast<std::int64_t>(target);
+        continue;
+      }
+    }
     // Re-aim: a secant step on achieved(selection target) through the last two rounds, its
     // slope kept in [0.5, 1] (refusals make the output move less than the selection, and pins
     // change the function between rounds), the target kept within [N/2, 3N/2].
     double slope = 1.0;
-    if (round > 1 && selection_target != previous_target)
+    if (previous_target > 0 && selection_target != previous_target)
       slope = std::clamp(double(achieved - previous_achieved) / double(selection_target - previous_target), 0.5, 1.0);
     previous_target = selection_target;
     previous_achieved = achieved;
