@@ -198,6 +198,24 @@ TEST(Formulation, UnreachableTargetIsReportedWithTheClosestSelection) {
   EXPECT_TRUE(eq4_holds(p, r.edge_kept));
 }
 
+TEST(Formulation, UnreachableTargetOnALargeModelKeepsTheGreedySelection) {
+  // The same cube, treated as a large model (whole_model_groups = 0): no whole-model MIP; the
+  // greedy selection, which collapses one ring (N' = 4, the count closest to 3), is the result.
+  AnalysisParams ap;
+  ap.segmentation.enable = false;
+  const Prepared p = prepare(make_cube(1), ap);
+  SelectionParams sp;
+  sp.whole_model_groups = 0;
+  const SelectionResult r = select_edges(p.mesh, p.conn, p.analysis, 3, sp);
+  EXPECT_EQ(r.strategy, "neighbourhoods");
+  EXPECT_FALSE(r.solver_ran);
+  EXPECT_FALSE(r.band_enforced);
+  EXPECT_NE(r.note.find("out of reach"), std::string::npos);
+  EXPECT_EQ(r.predicted, 4u);
+  EXPECT_EQ(r.stop_reason, "greedy");
+  EXPECT_TRUE(eq4_holds(p, r.edge_kept));
+}
+
 TEST(Formulation, TriangleOnlyMeshUsesTriangleClusters) {
   // Fan-triangulate a grid: no quads, no chords; every edge is its own group.
   const PolyMesh grid = make_grid(6, 6);

@@ -575,6 +575,26 @@ TEST(IlpCbc, StartCanServeAsFloorOnly) {
   EXPECT_TRUE(m.is_feasible(r.solution));
 }
 
+TEST(IlpCbc, StallStopsTheSearchWithoutClaimingOptimality) {
+  // A 300-item, 40-row knapsack needs a tree search; with a 1 ms stall limit the search stops at
+  // the first node that follows a millisecond without a better incumbent, long before the
+  // (generous) time limit and without a proof. The start, as cutoff, stays the floor.
+  Model m = random_knapsack(300, 40, 14);
+  const std::vector<double> start = greedy_start(m);
+  m.set_initial_solution(start);
+  SolveParams params;
+  params.time_limit_seconds = 600.0;
+  params.stall_seconds = 1e-3;
+  params.start_as_mip_start = false;
+  const SolveResult r = solve(m, params);
+  EXPECT_TRUE(r.stalled) << describe(r);
+  EXPECT_EQ(r.status, SolveStatus::Feasible) << describe(r);
+  ASSERT_TRUE(r.has_solution());
+  EXPECT_TRUE(m.is_feasible(r.solution));
+  EXPECT_LE(r.objective, m.evaluate(start) + 1e-9);
+  EXPECT_GT(r.gap, 0.0);
+}
+
 TEST(IlpCbc, StartSurvivesInvalidParameters) {
   Model m = random_knapsack(20, 3, 5);
   const std::vector<double> start = greedy_start(m);
@@ -645,7 +665,8 @@ TEST(IlpCbc, InvalidParametersAreReported) {
   for (auto bad : {+[](SolveParams& p) { p.time_limit_seconds = -1; },
                    +[](SolveParams& p) { p.time_limit_seconds = std::nan(""); },
                    +[](SolveParams& p) { p.threads = -2; },
-                   +[](SolveParams& p) { p.relative_gap = -0.1; }}) {
+                   +[](SolveParams& p) { p.relative_gap = -0.1; },
+                   +[](SolveParams& p) { p.stall_seconds = 0.0; }}) {
     SolveParams p;
     bad(p);
     const SolveResult r = solve(m, p);

@@ -116,9 +116,12 @@ struct RunContext {
   bool incumbent_before_search = false;
   ModelSize presolved;
 
-  // Progress reporting; the event handlers of CBC's worker threads share it.
+  // Progress reporting and the stall clock; the event handlers of CBC's worker threads share it.
   std::mutex progress_mutex;
   double best_reported = kInf;
+  double seconds_to_best = 0.0;
+  Clock::time_point last_improvement;  // start of branch-and-bound, then each improvement
+  bool stalled = false;
 };
 
 // CbcMain1's callback takes no user pointer; the driver calls it on the thread that called
@@ -143,6 +146,8 @@ int driver_callback(CbcModel* model, int where_from) {
     run->presolved = {solver->getNumRows(), solver->getNumCols(),
                       static_cast<std::int64_t>(solver->getNumElements()), solver->getNumIntegers()};
     run->incumbent_before_search = model->bestSolution() != nullptr;
+    std::lock_guard lock(run->progress_mutex);
+    run->last_improvement = Clock::now();
   }
   return 0;  // 0 = carry on
 }
@@ -157,23 +162,34 @@ class ProgressHandler : public CbcEventHandler {
   CbcEventHandler* clone() const override { return new ProgressHandler(*this); }
 
   CbcAction event(CbcEvent which) override {
-    if (!run_ || !model_ || !run_->params->on_progress) return noAction;
+    if (!run_ || !model_) return noAction;
     // "heuristicSolution" fires before the new incumbent is stored, so we poll the stored
     // incumbent on every event that can follow an improvement and report when it changed.
     if (which != solution && which != heuristicSolution && which != node && which != treeStatus &&
         which != endSearch)
       return noAction;
     const double obj = from_coin(model_->getObjValue());
-    if (!std::isfinite(obj)) return noAction;
     std::lock_guard lock(run_->progress_mutex);
-    if (!(obj < run_->best_reported - 1e-9 * std::max(1.0, std::abs(obj)))) return noAction;
-    run_->best_reported = obj;
-    Progress p{obj, from_coin(model_->getBestPossibleObjValue()), seconds_since(run_->t0)};
-    try {
-      run_->params->on_progress(p);
-    } catch (...) {
-      // The contract says the callback must not throw; an exception must not unwind through
-      // CBC's C-style stack frames either.
+    if (std::isfinite(obj) && obj < run_->best_reported - 1e-9 * std::max(1.0, std::abs(obj))) {
+      run_->best_reported = obj;
+      run_->seconds_to_best = seconds_since(run_->t0);
+      run_->last_improvement = Clock::now();
+      if (run_->params->on_progress) {
+        Progress p{obj, from_coin(model_->getBestPossibleObjValue()), run_->seconds_to_best};
+        try {
+          run_->params->on_progress(p);
+        } catch (...) {
+          // The contract says the callback must not throw; an exception must not unwind through
+          // CBC's C-style stack frames either.
+        }
+      }
+      return noAction;
+    }
+    // SolveParams::stall_seconds, checked between nodes (a "stop" there ends branch-and-bound).
+    if (which == node && std::isfinite(run_->params->stall_seconds) && run_->reached_branch_and_bound &&
+        seconds_since(run_->last_improvement) >= run_->params->stall_seconds) {
+      run_->stalled = true;
+      return stop;
     }
     return noAction;
   }
@@ -227,6 +243,8 @@ struct RunOutcome {
   bool root_lp_stopped = false;
   bool incumbent_before_search = false;
   bool time_limit_reached = false;
+  bool stalled = false;
+  double seconds_to_best = 0.0;
   ModelSize presolved;
   std::string error;  // CBC threw
 };
@@ -286,6 +304,7 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
 
   run.root_lp_infeasible = run.root_lp_stopped = run.reached_branch_and_bound = false;
   run.incumbent_before_search = false;
+  run.stalled = false;
   run.presolved = {};
   t_run = &run;
   try {
@@ -303,6 +322,8 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   out.root_lp_infeasible = run.root_lp_infeasible;
   out.root_lp_stopped = run.root_lp_stopped;
   out.incumbent_before_search = run.incumbent_before_search;
+  out.stalled = run.stalled;
+  out.seconds_to_best = run.seconds_to_best;
   out.presolved = run.presolved;
   if (!out.error.empty()) return out;
 
@@ -410,8 +431,9 @@ std::string pack(const RunOutcome& o) {
   w.put(o.nodes);
   w.put(o.iterations);
   for (bool b : {o.reached_branch_and_bound, o.root_lp_infeasible, o.root_lp_stopped,
-                 o.incumbent_before_search, o.time_limit_reached})
+                 o.incumbent_before_search, o.time_limit_reached, o.stalled})
     w.put<std::uint8_t>(b);
+  w.put(o.seconds_to_best);
   for (std::int64_t v : {o.presolved.rows, o.presolved.cols, o.presolved.nonzeros, o.presolved.integer_cols})
     w.put(v);
   w.put_string(o.error);
@@ -430,6 +452,8 @@ bool unpack(const char* data, std::size_t n, RunOutcome& o) {
   o.root_lp_stopped = r.get<std::uint8_t>();
   o.incumbent_before_search = r.get<std::uint8_t>();
   o.time_limit_reached = r.get<std::uint8_t>();
+  o.stalled = r.get<std::uint8_t>();
+  o.seconds_to_best = r.get<double>();
   o.presolved.rows = r.get<std::int64_t>();
   o.presolved.cols = r.get<std::int64_t>();
   o.presolved.nonzeros = r.get<std::int64_t>();
@@ -620,7 +644,8 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
     // Nothing better than the start exists (search complete) or was found (time ran out).
     // Only a finished search or an infeasible root LP proves it; pre-processing cut short by the
     // time limit also says "infeasible" (see the header comment).
-    const bool proven = (out.reached_branch_and_bound && !out.time_limit_reached) || out.root_lp_infeasible;
+    const bool proven =
+        (out.reached_branch_and_bound && !out.time_limit_reached && !out.stalled) || out.root_lp_infeasible;
     out.status = proven ? SolveStatus::Optimal : SolveStatus::NoSolution;
     if (out.status == SolveStatus::Optimal) out.best_bound = cutoff;
   }
@@ -663,6 +688,9 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
   result.best_bound = out.best_bound;
   result.nodes = out.nodes;
   result.iterations = out.iterations;
+  result.stalled = out.stalled;
+  result.seconds_to_best = out.seconds_to_best;
+  if (out.stalled && result.status == SolveStatus::Optimal) result.status = SolveStatus::Feasible;
   backend::finish(model, params, result);
   result.seconds = seconds_since(t0);
   return result;

@@ -94,6 +94,10 @@ struct SelectionParams {
   Index neighbourhood_groups = 50;
   /// Strategy Auto solves the whole model when at most this many groups are free.
   Index whole_model_groups = 400;
+  /// A whole-model MIP (the exact formulation, or strategy Whole) stops when branch-and-bound
+  /// has found nothing better for this many seconds (ilp::SolveParams::stall_seconds); the
+  /// result then says "stalled". Measured in docs/formulation.md ("Stopping").
+  double whole_stall_seconds = 20.0;
   /// Time limit of one neighbourhood MIP, seconds.
   double neighbourhood_time_limit = 0.1;
   /// Whether neighbourhood MIPs run in a child process like whole solves (ilp::SolveParams::
@@ -177,6 +181,15 @@ struct SelectionResult {
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
   double seconds_anneal = 0.0;
   SelectionModelStats model;
+  /// Why the selection stopped (docs/formulation.md, "Speed"): "nothing to do", "greedy" (no
+  /// time limit, or a target out of reach on a model too large for a whole MIP), "optimal" (whole-model MIP proven optimal), "converged" (the neighbourhood
+  /// search finished two sweeps without an improvement), "stalled" (whole-model MIP without an
+  /// improvement for SelectionParams::whole_stall_seconds), "time" (the time limit).
+  std::string stop_reason;
+  bool anneal_converged = false;        ///< the annealing schedule ended before the time did
+  bool flip_search_converged = false;   ///< the descent ended in a local optimum
+  /// Importance, groups, constraints, face terms and group adjacency.
+  double seconds_prepare = 0.0;
   double seconds_build = 0.0;
   double seconds_greedy = 0.0;
   double seconds_solve = 0.0;

@@ -84,6 +84,7 @@ std::string check_params(const SolveParams& p) {
   if (!(p.feasibility_tolerance >= 0.0) || std::isinf(p.feasibility_tolerance))
     return "feasibility_tolerance must be finite and >= 0";
   if (p.log_level < 0) return "log_level must be >= 0";
+  if (!(p.stall_seconds > 0.0)) return "stall_seconds must be > 0 (kInf = never)";
   return {};
 }
 

@@ -47,6 +47,12 @@ struct SolveParams {
   std::uint32_t seed = 1;
   /// Stop when gap (see SolveResult::gap) <= this, >= 0.
   double relative_gap = 1e-4;
+  /// Stop when branch-and-bound has gone this many wall-clock seconds without a better
+  /// incumbent (counted from the start of branch-and-bound or from the last improvement), > 0;
+  /// kInf = never. The result is then Feasible with `stalled` set. For searches that will not
+  /// close their gap in the budget (src/ilp/formulation.cpp: whole-model selections), so that a
+  /// solve which has stopped finding anything does not sit out the whole time limit.
+  double stall_seconds = kInf;
   /// Tolerance of the re-check every solution goes through (Model::max_violation, absolute).
   double feasibility_tolerance = 1e-6;
   /// Whether the model's initial solution is handed to the backend as a MIP start (true) or
@@ -114,6 +120,11 @@ struct SolveResult {
   double seconds = 0.0;         ///< wall-clock time of the whole solve() call
   std::int64_t nodes = 0;       ///< branch-and-bound nodes
   std::int64_t iterations = 0;  ///< LP (simplex) iterations
+  /// The search was stopped by SolveParams::stall_seconds (not by the time limit).
+  bool stalled = false;
+  /// Wall-clock seconds from entry to the last improvement of the incumbent (0 = none found:
+  /// the start, if any, stood).
+  double seconds_to_best = 0.0;
 
   ModelSize built;      ///< the model as handed to the backend
   /// The model that entered branch-and-bound, i.e. after the backend's pre-processing (CBC skips

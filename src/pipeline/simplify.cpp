@@ -106,9 +106,13 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"anneal_moves", s.anneal_moves},
       {"anneal_accepted", s.anneal_accepted},
       {"seconds_anneal", s.seconds_anneal},
+      {"seconds_prepare", s.seconds_prepare},
       {"seconds_build", s.seconds_build},
       {"seconds_greedy", s.seconds_greedy},
       {"seconds_solve", s.seconds_solve},
+      {"stop_reason", s.stop_reason},
+      {"anneal_converged", s.anneal_converged},
+      {"flip_search_converged", s.flip_search_converged},
   };
   if (s.solver_ran) {
     const ilp::SolveResult& r = s.solve;
@@ -129,6 +133,8 @@ nlohmann::json solve_json(const SelectionResult& s) {
         {"presolved_rows", r.presolved.rows},
         {"presolved_cols", r.presolved.cols},
         {"presolved_nonzeros", r.presolved.nonzeros},
+        {"stalled", r.stalled},
+        {"seconds_to_best", r.seconds_to_best},
     };
   }
   return j;
@@ -299,6 +305,16 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"undoing", trimming},
         {"seconds_select", select_seconds},
         {"time_limit_seconds", sp.solve.time_limit_seconds},
+        // Where the selection's time went (the budget covers all of it; docs/formulation.md).
+        {"selection_seconds",
+         {{"prepare", selection.seconds_prepare},
+          {"greedy", selection.seconds_greedy},
+          {"anneal", selection.seconds_anneal},
+          {"descent", selection.seconds_flip_search},
+          {"build", selection.seconds_build},
+          {"solve", selection.seconds_solve},
+          {"neighbourhood_build", selection.seconds_neighbourhood_build}}},
+        {"stop_reason", selection.stop_reason},
     };
     const double distance = std::abs(double(drift));
     const bool better = distance < best_distance;
