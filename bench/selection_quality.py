@@ -8,7 +8,13 @@ one at a time (the machine is shared: timings are wall clock), and reads report.
 Reports are kept in --out and reused (delete them to re-run). The gap of a run is
 (objective − best) / |best|, best = the lowest objective of any run on that mesh and ratio (both
 formulations optimise the same Eq. 9); `proven` is the solver's own gap where it has a bound
-(whole-model solves). `load` is the 1-minute load average when the run started.
+(whole-model solves). `load` is the 1-minute load average when the run started. `stop` is the
+selection's stop_reason (optimal / converged / stalled / time / greedy); `t best` is the solver
+time of the whole-model MIP's last improvement (whole strategy only). Rows / cols are the whole
+model as built; "presolved" is CBC's model after pre-processing (whole-model solves that reached
+branch-and-bound; the neighbourhood strategy never hands the whole model to CBC).
+--meshes all = every corpus mesh, largest file first; --skip-missing prints only the runs whose
+reports exist (to tabulate a partial run).
 """
 import argparse
 import json
@@ -31,11 +37,17 @@ def main():
     ap.add_argument("--limits", default="5,180", help="comma-separated --time-limit values, seconds")
     ap.add_argument("--out", default="/tmp/quadlod_selection_quality", help="reports and outputs")
     ap.add_argument("--tag", default="", help="suffix of the report names (to keep variants apart)")
+    ap.add_argument("--skip-missing", action="store_true", help="tabulate existing reports, run nothing")
     ap.add_argument("extra", nargs="*", help="more simplify arguments, after --")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     rows = []
-    for mesh in a.meshes.split(","):
+    meshes = a.meshes.split(",")
+    if a.meshes == "all":
+        objs = [f for f in os.listdir(a.corpus) if f.endswith(".obj")]
+        objs.sort(key=lambda f: -os.path.getsize(os.path.join(a.corpus, f)))
+        meshes = [f[:-4] for f in objs]
+    for mesh in meshes:
         src = os.path.join(a.corpus, mesh + ".obj")
         for ratio in a.ratios.split(","):
             for form in a.formulations.split(","):
@@ -43,6 +55,8 @@ def main():
                     name = f"{mesh}_r{ratio}_{form}_t{limit}{a.tag}"
                     report = os.path.join(a.out, name + ".json")
                     meta = os.path.join(a.out, name + ".load")
+                    if not os.path.exists(report) and a.skip_missing:
+                        continue
                     if not os.path.exists(report):
                         load = open("/proc/loadavg").read().split()[0]
                         cmd = [a.quadlod, "-q", "simplify", src, "-o", os.path.join(a.out, name + ".obj"),
@@ -60,20 +74,24 @@ def main():
     for r in rows:
         key = (r["mesh"], r["ratio"])
         best[key] = min(best.get(key, float("inf")), r["s"]["objective"])
-    print("| mesh | ratio | formulation | limit s | rows | cols | nonzeros | objective | gap to best | proven gap "
-          "| N' / N | select s | neighbourhoods | load |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| mesh | formulation | limit s | rows | cols | presolved rows | presolved cols | objective | gap to best "
+          "| proven gap | N' / N | select s | stop | t best s | neighbourhoods | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         s = r["s"]
         b = best[(r["mesh"], r["ratio"])]
         gap = (s["objective"] - b) / max(abs(b), 1e-9) * 100
         solver = s.get("solver", {})
+        whole = s.get("strategy") == "whole"
         proven = solver.get("gap")
-        proven = f"{100 * proven:.1f} %" if isinstance(proven, (int, float)) and s.get("strategy") == "whole" else "–"
-        print(f"| {r['mesh']} | {r['ratio']} | {r['form']} | {r['limit']} | {s['formulation_rows']} "
-              f"| {s['formulation_cols']} | {s['formulation_nonzeros']} | {s['objective']:.1f} | {gap:.2f} % "
-              f"| {proven} | {s['predicted']} / {s['target']} | {s['seconds']:.2f} "
-              f"| {s.get('neighbourhoods', 0)} | {r['load']} |")
+        proven = f"{100 * proven:.1f} %" if isinstance(proven, (int, float)) and whole else "–"
+        pr = solver.get("presolved_rows", -1) if whole else -1
+        pc = solver.get("presolved_cols", -1) if whole else -1
+        tb = f"{solver.get('seconds_to_best', 0):.1f}" if whole and solver.get("seconds_to_best") else "–"
+        print(f"| {r['mesh']} | {r['form']} | {r['limit']} | {s['formulation_rows']} "
+              f"| {s['formulation_cols']} | {pr if pr >= 0 else '–'} | {pc if pc >= 0 else '–'} "
+              f"| {s['objective']:.1f} | {gap:.2f} % | {proven} | {s['predicted']} / {s['target']} "
+              f"| {s['seconds']:.2f} | {s.get('stop_reason', '?')} | {tb} | {s.get('neighbourhoods', 0)} | {r['load']} |")
 
 
 if __name__ == "__main__":

@@ -52,6 +52,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--neighbourhood-groups", p.neighbourhood_groups,
                   "Groups freed per neighbourhood MIP (strategy neighbourhoods)")
       ->check(CLI::Range(1, 1000000))->capture_default_str()->group("Solver");
+  sub->add_option("--stall-seconds", p.stall_seconds,
+                  "Stop a whole-model MIP after this many seconds without a better selection (0 = never)")
+      ->check(CLI::Range(0.0, 86400.0))->default_str(std::to_string(default_stall_seconds()))->group("Solver");
   sub->add_option("--epsilon-n", p.epsilon_n, "Eq. 2 slack on the target")
       ->check(CLI::Range(0.0, 0.5))->capture_default_str()->group("Paper parameters");
   sub->add_option("--epsilon-theta", p.epsilon_theta_deg, "Segmentation breakpoint angle, degrees (§3.2.2)")

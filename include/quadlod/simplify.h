@@ -43,6 +43,9 @@ struct SimplifyOptions {
   std::string strategy = "auto";
   /// Groups freed per neighbourhood MIP (docs/parameters.md, "Solver strategy").
   Index neighbourhood_groups = 50;
+  /// A whole-model MIP stops after this many seconds without a better selection; 0 = never
+  /// (SelectionParams::whole_stall_seconds, docs/formulation.md "Stopping").
+  double stall_seconds = -1.0;  ///< < 0 = the measured default (default_stall_seconds())
   std::string solver = "cbc";
 
   // --- rounds (beyond the paper) ------------------------------------------------------------
@@ -109,6 +112,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options);
 
 /// The measured defaults of λ_geo and λ_edge (see docs/parameters.md).
 double default_lambda_geo();
+double default_stall_seconds();
 double default_lambda_edge();
 double default_lambda_tri();
 

@@ -120,6 +120,7 @@ struct RunContext {
   std::mutex progress_mutex;
   double best_reported = kInf;
   double seconds_to_best = 0.0;
+  double seconds_to_search = 0.0;
   Clock::time_point last_improvement;  // start of branch-and-bound, then each improvement
   bool stalled = false;
 };
@@ -148,6 +149,7 @@ int driver_callback(CbcModel* model, int where_from) {
     run->incumbent_before_search = model->bestSolution() != nullptr;
     std::lock_guard lock(run->progress_mutex);
     run->last_improvement = Clock::now();
+    run->seconds_to_search = seconds_since(run->t0);
   }
   return 0;  // 0 = carry on
 }
@@ -244,7 +246,7 @@ struct RunOutcome {
   bool incumbent_before_search = false;
   bool time_limit_reached = false;
   bool stalled = false;
-  double seconds_to_best = 0.0;
+  double seconds_to_best = 0.0, seconds_to_search = 0.0;
   ModelSize presolved;
   std::string error;  // CBC threw
 };
@@ -305,6 +307,7 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   run.root_lp_infeasible = run.root_lp_stopped = run.reached_branch_and_bound = false;
   run.incumbent_before_search = false;
   run.stalled = false;
+  run.seconds_to_search = 0.0;
   run.presolved = {};
   t_run = &run;
   try {
@@ -324,6 +327,7 @@ RunOutcome run_cbc(const Model& model, const CoinProblem& problem, const SolvePa
   out.incumbent_before_search = run.incumbent_before_search;
   out.stalled = run.stalled;
   out.seconds_to_best = run.seconds_to_best;
+  out.seconds_to_search = run.seconds_to_search;
   out.presolved = run.presolved;
   if (!out.error.empty()) return out;
 
@@ -434,6 +438,7 @@ std::string pack(const RunOutcome& o) {
                  o.incumbent_before_search, o.time_limit_reached, o.stalled})
     w.put<std::uint8_t>(b);
   w.put(o.seconds_to_best);
+  w.put(o.seconds_to_search);
   for (std::int64_t v : {o.presolved.rows, o.presolved.cols, o.presolved.nonzeros, o.presolved.integer_cols})
     w.put(v);
   w.put_string(o.error);
@@ -454,6 +459,7 @@ bool unpack(const char* data, std::size_t n, RunOutcome& o) {
   o.time_limit_reached = r.get<std::uint8_t>();
   o.stalled = r.get<std::uint8_t>();
   o.seconds_to_best = r.get<double>();
+  o.seconds_to_search = r.get<double>();
   o.presolved.rows = r.get<std::int64_t>();
   o.presolved.cols = r.get<std::int64_t>();
   o.presolved.nonzeros = r.get<std::int64_t>();
@@ -690,6 +696,7 @@ SolveResult CbcBackend::solve(const Model& model, const SolveParams& params) {
   result.iterations = out.iterations;
   result.stalled = out.stalled;
   result.seconds_to_best = out.seconds_to_best;
+  result.seconds_to_search = out.seconds_to_search;
   if (out.stalled && result.status == SolveStatus::Optimal) result.status = SolveStatus::Feasible;
   backend::finish(model, params, result);
   result.seconds = seconds_since(t0);

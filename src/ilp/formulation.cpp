@@ -1225,6 +1225,31 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   std::uint32_t round = 0;
   const double t0 = params.anneal_t0, t1 = params.anneal_t1;
   double temperature = t0;
+  // The best selection is kept as best_y plus a journal of the groups flipped since: a new best
+  // copies only those (a full copy per improvement cost O(groups) each time). A journal longer
+  // than the groups falls back to one full copy.
+  std::vector<Index> journal;
+  bool journal_full = false;
+  auto record = [&](Index grp) {
+    if (journal_full) return;
+    journal.push_back(grp);
+    if (journal.size() > movable.size()) {
+      journal_full = true;
+      journal.clear();
+    }
+  };
+  auto accept = [&](double delta) {
+    ++stats.accepted;
+    current += delta;
+    if (current < best - 1e-9) {
+      best = current;
+      if (journal_full) best_y = st.y;
+      else
+        for (Index grp : journal) best_y[grp] = st.y[grp];
+      journal.clear();
+      journal_full = false;
+    }
+  };
   // Flips grp if allowed; false (nothing done) when a collapse would break Eq. 8.
   auto apply = [&](Index grp, double& rest) {
     if (st.y[grp] && !st.may_collapse(grp)) return false;
@@ -1258,7 +1283,17 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
     flipped.clear();
     const std::uint64_t kind = rng() % 3;
     if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
-      if (!apply(a, rest)) continue;
+      // A single flip is judged before it is made: most moves are rejected, and flipping and
+      // undoing them costs as much as the evaluation.
+      if (st.y[a] && !st.may_collapse(a)) continue;
+      const std::int64_t dc = st.delta_count(a);
+      if (!in_band(c0 + dc)) continue;
+      const double delta = count_term(c0 + dc) - count_term(c0) + st.delta_rest(a, params);
+      if (delta > 0.0 && unit(rng) >= std::exp(-delta / temperature)) continue;
+      st.flip(a, dc);
+      record(a);
+      accept(delta);
+      continue;
     } else if (kind == 1) {  // swap with an adjacent group of the other value
       const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
       if (g.fixed[b] || st.y[b] == st.y[a]) continue;
@@ -1289,12 +1324,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       undo();
       continue;
     }
-    ++stats.accepted;
-    current += delta;
-    if (current < best - 1e-9) {
-      best = current;
-      best_y = st.y;
-    }
+    for (const auto& fl : flipped) record(fl.first);
+    accept(delta);
   }
   return best_y;
 }

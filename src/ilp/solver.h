@@ -125,6 +125,9 @@ struct SolveResult {
   /// Wall-clock seconds from entry to the last improvement of the incumbent (0 = none found:
   /// the start, if any, stood).
   double seconds_to_best = 0.0;
+  /// Wall-clock seconds from entry to the start of branch-and-bound (0 = never reached: root
+  /// LP cut short, or the problem settled before it).
+  double seconds_to_search = 0.0;
 
   ModelSize built;      ///< the model as handed to the backend
   /// The model that entered branch-and-bound, i.e. after the backend's pre-processing (CBC skips

@@ -20,6 +20,7 @@
 namespace quadlod {
 
 double default_lambda_geo() { return SelectionParams{}.lambda_geo; }
+double default_stall_seconds() { return SelectionParams{}.whole_stall_seconds; }
 double default_lambda_edge() { return SelectionParams{}.lambda_edge; }
 double default_lambda_tri() { return SelectionParams{}.lambda_tri; }
 
@@ -135,6 +136,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
         {"presolved_nonzeros", r.presolved.nonzeros},
         {"stalled", r.stalled},
         {"seconds_to_best", r.seconds_to_best},
+        {"seconds_to_search", r.seconds_to_search},
     };
   }
   return j;
@@ -415,6 +417,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (options.lambda_tri >= 0.0) sp.lambda_tri = options.lambda_tri;
   sp.formulation = options.exact_formulation ? Formulation::Exact : Formulation::Fast;
   sp.neighbourhood_groups = std::max<Index>(1, options.neighbourhood_groups);
+  if (options.stall_seconds >= 0.0)
+    sp.whole_stall_seconds = options.stall_seconds > 0.0 ? options.stall_seconds : ilp::kInf;
   if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
   else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
   else if (options.strategy != "auto") {
@@ -568,6 +572,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"formulation", options.exact_formulation ? "exact" : "fast"},
       {"strategy", options.strategy},
       {"neighbourhood_groups", sp.neighbourhood_groups},
+      {"stall_seconds", std::isfinite(sp.whole_stall_seconds) ? nlohmann::json(sp.whole_stall_seconds) : nlohmann::json()},
       {"consistency", options.consistency},
       {"segmentation", options.segmentation},
       {"geometry", options.geometry},
