@@ -1557,6 +1557,16 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     return y;
   };
 
+  // The whole model is built before the local search, so that the annealing's and the descent's
+  // shares of the budget (fractions of the time since select_edges() began) account for it: built
+  // after them, it overran 0.625 s budgets by 0.1-0.2 s on cg57.
+  Stopwatch build_clock;
+  ModelBuilder banded(mesh, conn, analysis, groups, gc, fg, importance, params);
+  banded.build(target, true);
+  result.model = banded.stats;
+  result.model.size = banded.model.size();
+  result.seconds_build = build_clock.seconds();
+
   // The greedy selection, polished by single flips and adjacent swaps, is the start of every
   // solve (skipped for a greedy-only run and when the greedy misses the band).
   std::vector<std::uint8_t> start_y = greedy.y;
@@ -1591,14 +1601,8 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.seconds_flip_search = flip_clock.seconds();
   }
 
-  Stopwatch build_clock;
-  ModelBuilder banded(mesh, conn, analysis, groups, gc, fg, importance, params);
-  banded.build(target, true);
   const std::vector<double> banded_start = banded.complete(start_y, target);
   if (reachable) banded.model.set_initial_solution(banded_start);
-  result.model = banded.stats;
-  result.model.size = banded.model.size();
-  result.seconds_build = build_clock.seconds();
 
   std::vector<double> solution;
   const ModelBuilder* used = &banded;
@@ -1626,14 +1630,22 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.band_enforced = true;
   } else if (time_limit > 0.0 && !(neighbourhoods && large)) {
     // Phase 1 only where the whole model is small enough to be searched (at most
-    // whole_model_groups free groups): on the large models of the neighbourhood strategy a whole-model MIP never found a point in
-    // the band in its half of the budget (cg57 at 0.4, rounds after pins: 0 of 15), but each
-    // call cost 1–2 s beyond its limit (loading 300k rows, the child process).
+    // whole_model_groups free groups): on the large models of the neighbourhood strategy a
+    // whole-model MIP never found a point in the band in its half of the budget (cg57 at 0.4,
+    // rounds after pins: 0 of 18), but each call cost 1–3 s beyond its limit (loading 300k rows,
+    // the child process).
     solution = run(banded, 0.5 * time_limit);
     result.band_enforced = !solution.empty();
   }
   std::optional<ModelBuilder> open;
-  if (solution.empty()) {
+  if (solution.empty() && time_limit > 0.0 && neighbourhoods && large) {
+    // On a large model the greedy selection stays: it went as close to N as the hard
+    // constraints let it, and Eq. 9 without the band would trade count for λ_geo (a search of
+    // the open model raised N' by ~3 % on cg57's later rounds, away from the target). The banded
+    // model evaluates it like the open one would (same objective; only p's or q's bound is off).
+    solution = banded.complete(greedy.y, target);
+    result.greedy_objective = banded.model.evaluate(solution);
+  } else if (solution.empty()) {
     Stopwatch rebuild_clock;
     open.emplace(mesh, conn, analysis, groups, gc, fg, importance, params);
     open->build(target, false);
@@ -1641,10 +1653,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     open->model.set_initial_solution(start);
     result.greedy_objective = open->model.evaluate(start);
     result.seconds_build += rebuild_clock.seconds();
-    if (time_limit > 0.0 && !(neighbourhoods && large)) solution = run(*open, 0.5 * time_limit);
-    // On a large model the greedy selection stays: it went as close to N as the hard
-    // constraints let it, and Eq. 9 without the band would trade count for λ_geo (a search of
-    // the open model raised N' by ~3 % on cg57's later rounds, away from the target).
+    solution = time_limit > 0.0 ? run(*open, 0.5 * time_limit) : start;
     if (solution.empty()) solution = start;
     used = &*open;
   }
