@@ -135,6 +135,21 @@ std::vector<double> greedy_start(const Model& m) {
   return x;
 }
 
+// A 300-item, 40-row knapsack carrying its greedy point as initial solution, handed to CBC as a
+// cutoff only: a search CBC cannot finish quickly, with a floor for its result.
+Model knapsack_with_floor(unsigned seed) {
+  Model m = random_knapsack(300, 40, seed);
+  m.set_initial_solution(greedy_start(m));
+  return m;
+}
+
+// The floor guarantee (solver.h): a feasible solution at least as good as the start.
+void expect_start_is_the_floor(const Model& m, const SolveResult& r) {
+  ASSERT_TRUE(r.has_solution()) << describe(r);
+  EXPECT_TRUE(m.is_feasible(r.solution)) << m.describe_violation(r.solution);
+  EXPECT_LE(r.objective, m.evaluate(m.initial_solution()) + 1e-9) << describe(r);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Model
 
@@ -560,9 +575,7 @@ TEST(IlpCbc, RootLpCutShortByTheTimeLimitIsReported) {
 }
 
 TEST(IlpCbc, StartCanServeAsFloorOnly) {
-  Model m = random_knapsack(300, 40, 12);
-  const std::vector<double> start = greedy_start(m);
-  m.set_initial_solution(start);
+  const Model m = knapsack_with_floor(12);
   SolveParams params;
   params.time_limit_seconds = 0.02;
   params.start_as_mip_start = false;
@@ -570,18 +583,13 @@ TEST(IlpCbc, StartCanServeAsFloorOnly) {
   EXPECT_EQ(r.start, StartStatus::NotUsed);
   EXPECT_TRUE(r.start_feasible);
   EXPECT_EQ(r.status, SolveStatus::Feasible) << describe(r);
-  ASSERT_TRUE(r.has_solution());
-  EXPECT_LE(r.objective, m.evaluate(start) + 1e-9);
-  EXPECT_TRUE(m.is_feasible(r.solution));
+  expect_start_is_the_floor(m, r);
 }
 
 TEST(IlpCbc, StallStopsTheSearchWithoutClaimingOptimality) {
-  // A 300-item, 40-row knapsack needs a tree search; with a 1 ms stall limit the search stops at
-  // the first node that follows a millisecond without a better incumbent, long before the
-  // (generous) time limit and without a proof. The start, as cutoff, stays the floor.
-  Model m = random_knapsack(300, 40, 14);
-  const std::vector<double> start = greedy_start(m);
-  m.set_initial_solution(start);
+  // With a 1 ms stall limit the search stops at the first node that follows a millisecond
+  // without a better incumbent, long before the (generous) time limit and without a proof.
+  const Model m = knapsack_with_floor(14);
   SolveParams params;
   params.time_limit_seconds = 600.0;
   params.stall_seconds = 1e-3;
@@ -589,9 +597,7 @@ TEST(IlpCbc, StallStopsTheSearchWithoutClaimingOptimality) {
   const SolveResult r = solve(m, params);
   EXPECT_TRUE(r.stalled) << describe(r);
   EXPECT_EQ(r.status, SolveStatus::Feasible) << describe(r);
-  ASSERT_TRUE(r.has_solution());
-  EXPECT_TRUE(m.is_feasible(r.solution));
-  EXPECT_LE(r.objective, m.evaluate(start) + 1e-9);
+  expect_start_is_the_floor(m, r);
   EXPECT_GT(r.gap, 0.0);
 }
 
