@@ -303,7 +303,9 @@ TEST(Formulation, PinnedEdgesStayKept) {
   sp.keep_edges = pin;
   const SelectionResult pinned_run = select_edges(p.mesh, p.conn, p.analysis, 36, sp);
   for (Index e = 0; e < p.conn.num_edges; ++e)
-    if (pin[e]) EXPECT_TRUE(pinned_run.edge_kept[e]) << "edge " << e;
+    if (pin[e]) {
+      EXPECT_TRUE(pinned_run.edge_kept[e]) << "edge " << e;
+    }
   // The selection collapsed other chords instead and still reaches the band.
   EXPECT_TRUE(pinned_run.band_enforced);
   EXPECT_NEAR(double(pinned_run.predicted), 36.0, 0.03 * 36.0 + 1e-9);
@@ -422,7 +424,9 @@ TEST(Formulation, LocalSearchNeverWorsensAndKeepsEveryConstraint) {
         EXPECT_TRUE(eq4_holds(*p, kept));
         EXPECT_TRUE(eq8_holds(*p, kept));
         for (Index e = 0; e < p->conn.num_edges; ++e)
-          if (pin[e]) EXPECT_TRUE(kept[e]) << "pinned edge " << e;
+          if (pin[e]) {
+            EXPECT_TRUE(kept[e]) << "pinned edge " << e;
+          }
         if (p == &small) {
           EXPECT_GE(after, oracle_optimum(*p, target, sp) - 1e-9);
         }
