@@ -441,8 +441,11 @@ TEST(ClusterCollapse, UntrustedMinimiserFallsBackInsideTheCluster) {
     const ClusterCollapseParams params = use_bare ? bare : ClusterCollapseParams{};
     const ClusterCollapseResult r = collapse_clusters(in, conn, kept, params);
     expect_valid_output(in, r);
-    if (use_bare) EXPECT_GT(r.stats.placements_fallback, 0u);
-    else EXPECT_EQ(r.stats.placements_fallback, 0u);
+    if (use_bare) {
+      EXPECT_GT(r.stats.placements_fallback, 0u);
+    } else {
+      EXPECT_EQ(r.stats.placements_fallback, 0u);
+    }
     EXPECT_GT(r.stats.clusters, 10u);
     std::vector<BoundingBox> boxes(r.mesh.num_vertices());
     for (Index v = 0; v < in.num_vertices(); ++v)

@@ -85,7 +85,9 @@ TEST(DualRepair, LongChainIsSplitUntilNoSuperFaceRemains) {
   EXPECT_GE(r.stats.splits, 2u);
   // Repair only ever restores edges of the selection (erosion aside, which has nothing to do here).
   for (Index e = 0; e < conn.num_edges; ++e)
-    if (kept[e]) EXPECT_TRUE(r.edge_kept[e]);
+    if (kept[e]) {
+      EXPECT_TRUE(r.edge_kept[e]);
+    }
 }
 
 TEST(DualRepair, HighValenceInputVertexSetsItsClustersLimit) {
