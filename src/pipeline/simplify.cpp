@@ -235,20 +235,19 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   // for N = 581). Up to `kTrimRounds` such rounds are added to max_rounds (none with
   // --max-rounds 1, the paper's single round).
   constexpr int kTrimRounds = 2;
-  std::vector<std::uint8_t> trim_keep;   // kept in the closest round below N, while undoing
+  bool undoing = false;
   std::vector<std::uint8_t> below_keep;  // kept in the closest round below N so far
   double below_distance = INFINITY;
   int round_limit = max_rounds;
   for (int round = 1; round <= round_limit; ++round) {
-    const bool trimming = !trim_keep.empty();
-    const std::string tag = (round == 1 ? std::string() : " (round " + std::to_string(round) + (trimming ? ", undoing" : "") + ")") + pass_tag;
+        const std::string tag = (round == 1 ? std::string() : " (round " + std::to_string(round) + (undoing ? ", undoing" : "") + ")") + pass_tag;
     sp.solve.time_limit_seconds = round == 1 ? time_limit : time_limit * options.later_round_time_fraction;
     sp.keep_edges = pinned;
-    if (trimming)
-      for (Index e = 0; e < conn.num_edges; ++e) sp.keep_edges[e] |= trim_keep[e];
+    if (undoing)
+      for (Index e = 0; e < conn.num_edges; ++e) sp.keep_edges[e] |= below_keep[e];
     // Undoing decides edge by edge (no Eq. 4): refusals bisected clusters of the round undone,
     // so its collapsed edges are parts of segments, which Eq. 4 would keep whole — and lose.
-    sp.consistency = options.consistency && !trimming;
+    sp.consistency = options.consistency && !undoing;
     clock = Stopwatch();
     const SelectionResult selection =
         select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
@@ -304,7 +303,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"refused_tri_equivalents",
          std::int64_t(collapsed.stats.tri_equivalent_out) - std::int64_t(collapsed.stats.tri_equivalent_wanted)},
         {"newly_pinned_edges", newly_pinned},
-        {"undoing", trimming},
+        {"undoing", undoing},
         {"seconds_select", select_seconds},
         {"time_limit_seconds", sp.solve.time_limit_seconds},
         // Where the selection's time went (the budget covers all of it; docs/formulation.md).
@@ -351,15 +350,12 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     }
     rounds.push_back(std::move(round_json));
     if (!reducing || distance <= options.round_tolerance * double(target)) break;
-    if (!below_keep.empty()) {
-      const bool first = trim_keep.empty();
-      trim_keep = below_keep;
-      if (first) {
-        round_limit = std::max(round_limit, round) + kTrimRounds;
-        previous_target = 0;  // a new function of the selection target: no secant across
-        selection_target = static_cast<std::int64_t>(target);
-        continue;
-      }
+    if (!below_keep.empty() && !undoing) {
+      undoing = true;
+      round_limit = std::max(round_limit, round) + kTrimRounds;
+      previous_target = 0;  // a new function of the selection target: no secant across
+      selection_target = static_cast<std::int64_t>(target);
+      continue;
     }
     // Re-aim: a secant step on achieved(selection target) through the last two rounds, its
     // slope kept in [0.5, 1] (refusals make the output move less than the selection, and pins
