@@ -436,3 +436,108 @@ TEST(Formulation, LocalSearchNeverWorsensAndKeepsEveryConstraint) {
   EXPECT_GE(searched, 16);
   EXPECT_GE(improved, 2);  // the search did something
 }
+
+namespace {
+// The local search of select_edges() (detail::local_search) from the count-only greedy selection,
+// as in LocalSearchNeverWorsensAndKeepsEveryConstraint.
+struct SearchCase {
+  const Prepared* p;
+  std::uint64_t target;
+  std::vector<std::uint8_t> start;
+};
+std::vector<SearchCase> search_cases(const std::vector<const Prepared*>& meshes, const SelectionParams& sp) {
+  std::vector<SearchCase> cases;
+  for (const Prepared* p : meshes) {
+    const std::uint64_t input = tri_equivalent_count(p->mesh);
+    for (double ratio : {0.8, 0.6, 0.4, 0.2}) {
+      const auto target = static_cast<std::uint64_t>(std::llround(ratio * double(input)));
+      SelectionParams count_only = sp;
+      count_only.lambda_geo = count_only.lambda_edge = count_only.lambda_tri = 0.0;
+      count_only.solve.time_limit_seconds = 0;
+      const SelectionResult greedy = select_edges(p->mesh, p->conn, p->analysis, target, count_only);
+      if (std::abs(double(greedy.predicted) - double(target)) > sp.epsilon_n * double(target)) continue;
+      cases.push_back({p, target, greedy.edge_kept});
+    }
+  }
+  return cases;
+}
+}  // namespace
+
+TEST(Formulation, CompoundMovesFindWhatSingleMovesCannot) {
+  // Descent only (no annealing): with compound moves the local optimum is never worse, on some
+  // instance strictly better, and every constraint holds.
+  const Prepared torus = prepare(mixed_torus());
+  const Prepared grid = prepare(make_grid(12, 12));
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_time_fraction = 0.0;
+  int better = 0, cases = 0;
+  for (const SearchCase& c : search_cases({&torus, &grid}, sp)) {
+    SelectionParams without = sp, with = sp;
+    without.compound_moves = false;
+    with.compound_moves = true;
+    const auto a = detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, without, c.start, 60.0);
+    const auto b = detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, with, c.start, 60.0);
+    const double ea = eq9(*c.p, a, c.target, sp), eb = eq9(*c.p, b, c.target, sp);
+    EXPECT_LE(eb, eq9(*c.p, c.start, c.target, sp) + 1e-9);
+    EXPECT_LE(std::abs(double(predicted_tri_equivalent(c.p->mesh, c.p->conn, b)) - double(c.target)),
+              sp.epsilon_n * double(c.target) + 1e-9);
+    EXPECT_TRUE(eq4_holds(*c.p, b));
+    EXPECT_TRUE(eq8_holds(*c.p, b));
+    better += eb < ea - 1e-9;
+    ++cases;
+  }
+  EXPECT_GE(cases, 4);
+  EXPECT_GE(better, 1) << "compound moves never found anything the other moves could not";
+}
+
+TEST(Formulation, RelaxedAnnealingEndsInTheBandAndKeepsEveryConstraint) {
+  // Penalty continuation: the annealing may leave Eq. 2's band before the ramp, but what it
+  // returns lies in it. A schedule ended by its move count (anneal_moves_per_group, not the
+  // clock) makes the chain deterministic for a fixed seed.
+  const Prepared torus = prepare(mixed_torus());
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_time_fraction = 0.8;
+  sp.anneal_moves_per_group = 200;
+  sp.anneal_count_weight = 0.0;
+  sp.anneal_band_relax = 3.0;
+  for (const SearchCase& c : search_cases({&torus}, sp)) {
+    const auto kept = detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, sp, c.start, 600.0);
+    EXPECT_LE(std::abs(double(predicted_tri_equivalent(c.p->mesh, c.p->conn, kept)) - double(c.target)),
+              sp.epsilon_n * double(c.target) + 1e-9);
+    EXPECT_LE(eq9(*c.p, kept, c.target, sp), eq9(*c.p, c.start, c.target, sp) + 1e-9);
+    EXPECT_TRUE(eq4_holds(*c.p, kept));
+    EXPECT_TRUE(eq8_holds(*c.p, kept));
+    // Same seed, same moves: the same selection again.
+    EXPECT_EQ(kept, detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, sp, c.start, 600.0));
+  }
+}
+
+TEST(Formulation, ParallelAnnealingChainsGiveTheBestSerialChain) {
+  // solve.threads = k runs k chains (seeds seed, seed + 1, …) and keeps the one with the lowest
+  // Eq. 9; with schedules ended by move count (deterministic) the result is one of the serial
+  // runs with those seeds, the same every time whichever thread finishes first.
+  const Prepared torus = prepare(mixed_torus());
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_time_fraction = 0.8;
+  sp.anneal_moves_per_group = 200;
+  int cases = 0;
+  for (const SearchCase& c : search_cases({&torus}, sp)) {
+    SelectionParams parallel = sp;
+    parallel.solve.threads = 3;
+    const auto b = detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, parallel, c.start, 600.0);
+    bool found = false;
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      SelectionParams serial = sp;
+      serial.solve.threads = 1;
+      serial.solve.seed = sp.solve.seed + k;
+      found |= detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, serial, c.start, 600.0) == b;
+    }
+    EXPECT_TRUE(found) << "target " << c.target;
+    EXPECT_EQ(b, detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, parallel, c.start, 600.0));
+    ++cases;
+  }
+  EXPECT_GE(cases, 2);
+}

@@ -32,10 +32,12 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <optional>
 #include <queue>
 #include <random>
+#include <thread>
 
 namespace quadlod {
 
@@ -297,6 +299,13 @@ class SelectionState {
     for (Index cl : gc_.group_tri[grp]) tri_collapsed_[cl] += collapse ? 1 : Index(-1);
   }
 
+  /// Whether grp (collapsed) lies in an Eq. 6 cluster with every group collapsed.
+  bool in_emptied_cluster(Index grp) const {
+    for (Index cl : gc_.group_geo[grp])
+      if (geo_kept_[cl] == 0) return true;
+    return false;
+  }
+
   std::vector<std::uint8_t> y;
   std::int64_t count = 0;
 
@@ -328,9 +337,10 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
   };
   std::priority_queue<Entry> heap;
   // Key: cost per removed triangle-equivalent of collapsing a kept group.
+  auto key_of = [&](Index grp, std::int64_t d) { return st.delta_rest(grp, params) / double(d); };
   auto push = [&](Index grp) {
     const std::int64_t d = -st.delta_count(grp);
-    if (d > 0) heap.push({st.delta_rest(grp, params) / double(d), grp, d});
+    if (d > 0) heap.push({key_of(grp, d), grp, d});
   };
   for (Index grp = 0; grp < g.count; ++grp)
     if (!g.fixed[grp]) push(grp);
@@ -346,7 +356,7 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
     if (!st.y[top.group]) continue;
     const std::int64_t d = -st.delta_count(top.group);
     if (d <= 0) continue;
-    const double key = st.delta_rest(top.group, params) / double(d);
+    const double key = key_of(top.group, d);
     if (d != top.delta || key != top.key) {  // stale entry: its neighbours changed
       heap.push({key, top.group, d});
       continue;
@@ -962,6 +972,7 @@ struct FlipSearchStats {
   Index swaps = 0;
   Index exchanges = 0;
   Index chains = 0;
+  Index compounds = 0;
   bool converged = false;
 };
 
@@ -1124,6 +1135,116 @@ bool pair_exchanges(SelectionState& st, const Groups& g, std::uint64_t target, c
   return applied;
 }
 
+// Compound moves (an ejection chain; beyond the paper, docs/formulation.md, "Speed"): flip a seed
+// group, then flip nearby groups the other way — cheapest Eq. 9 change per triangle-equivalent
+// first — until N' is back across its value before the move. The typical one re-opens an emptied
+// Eq. 6 cluster: keeping one of its groups saves λ_geo but adds its faces to N' (|ΔN'| of a long
+// chord is tens of triangle-equivalents, far more than λ_geo, so the single flip and the pair
+// exchanges rarely pay), and several small groups around it, collapsed, remove those faces again
+// without emptying another cluster. The reverse (collapse a large group, keep small ones around
+// it) comes with the same code. Candidates: the groups of the other value within a breadth-first
+// walk over groups that share a face, up to `compound_candidates`. The prefix of the chain with the
+// best Eq. 9 change inside Eq. 2's band is kept (its flips are in `flipped`); the rest is undone.
+// Returns that change, or +∞ with the state unchanged when no prefix lies in the band.
+//
+//        keep ║            ║ = the seed's chord, kept again: its cluster keeps an edge (−λ_geo),
+//    ─────────╫──────      N' rises by its faces;
+//     ┆   ┆   ║   ┆   ┆    ┆ = small chords around it, collapsed: N' falls back
+struct CompoundScratch {
+  std::vector<Index> queue;
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t round = 0;
+  struct Candidate {
+    double key;
+    Index grp;
+  };
+  std::vector<Candidate> candidates;
+};
+
+double compound_move(SelectionState& st, Index seed, const Groups& g, const std::vector<Index>& adj_offsets,
+                     const std::vector<Index>& adjacent, std::uint64_t target, const SelectionParams& params,
+                     CompoundScratch& s, std::vector<std::pair<Index, std::int64_t>>& flipped) {
+  const double n = double(target), band = params.epsilon_n * n;
+  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
+  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  flipped.clear();
+  if (g.fixed[seed] || (st.y[seed] && !st.may_collapse(seed))) return INFINITY;
+  const std::int64_t c0 = st.count, dc0 = st.delta_count(seed);
+  if (dc0 == 0) return INFINITY;  // nothing to compensate: a single flip
+  const double ct0 = count_term(c0);
+  double rest = st.delta_rest(seed, params);
+  st.flip(seed, dc0);
+  flipped.emplace_back(seed, dc0);
+  const std::uint8_t v = st.y[seed];  // candidates hold the seed's new value and flip away from it
+  const std::int64_t dir = dc0 > 0 ? 1 : -1;
+  if (s.stamp.size() != g.count) s.stamp.assign(g.count, 0), s.round = 0;
+  if (++s.round == 0) std::fill(s.stamp.begin(), s.stamp.end(), 0), s.round = 1;
+  s.queue.assign(1, seed);
+  s.stamp[seed] = s.round;
+  s.candidates.clear();
+  const std::size_t max_candidates = params.compound_candidates, max_visits = 8 * max_candidates;
+  for (std::size_t head = 0; head < s.queue.size() && s.candidates.size() < max_candidates; ++head) {
+    const Index a = s.queue[head];
+    if (a != seed && !g.fixed[a] && st.y[a] == v && (!v || st.may_collapse(a))) {
+      const std::int64_t dc = st.delta_count(a);
+      if (dc * dir < 0) s.candidates.push_back({st.delta_rest(a, params) / double(std::abs(dc)), a});
+    }
+    for (Index k = adj_offsets[a]; k < adj_offsets[a + 1] && s.queue.size() < max_visits; ++k)
+      if (s.stamp[adjacent[k]] != s.round) {
+        s.stamp[adjacent[k]] = s.round;
+        s.queue.push_back(adjacent[k]);
+      }
+  }
+  std::sort(s.candidates.begin(), s.candidates.end(), [](const CompoundScratch::Candidate& l,
+                                                         const CompoundScratch::Candidate& r) {
+    return l.key != r.key ? l.key < r.key : l.grp < r.grp;
+  });
+  double best = in_band(st.count) ? count_term(st.count) - ct0 + rest : INFINITY;
+  std::size_t best_len = in_band(st.count) ? 1 : 0;
+  for (const auto& cand : s.candidates) {
+    if ((st.count - c0) * dir <= 0) break;  // N' is back
+    const Index a = cand.grp;
+    if (st.y[a] != v || (v && !st.may_collapse(a))) continue;
+    const std::int64_t dc = st.delta_count(a);  // exact now: earlier flips may share its faces
+    if (dc * dir >= 0) continue;
+    rest += st.delta_rest(a, params);
+    st.flip(a, dc);
+    flipped.emplace_back(a, dc);
+    const double change = count_term(st.count) - ct0 + rest;
+    if (in_band(st.count) && change < best) {
+      best = change;
+      best_len = flipped.size();
+    }
+  }
+  while (flipped.size() > best_len) {
+    st.flip(flipped.back().first, -flipped.back().second);
+    flipped.pop_back();
+  }
+  return best_len > 0 ? best : INFINITY;
+}
+
+// Compound moves in the descent: every free group as a seed, a move kept when it lowers Eq. 9.
+bool compound_moves(SelectionState& st, const Groups& g, const std::vector<Index>& adj_offsets,
+                    const std::vector<Index>& adjacent, std::uint64_t target, const SelectionParams& params,
+                    const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
+  CompoundScratch scratch;
+  std::vector<std::pair<Index, std::int64_t>> flipped;
+  bool applied = false;
+  for (Index seed = 0; seed < g.count && clock.seconds() < seconds; ++seed) {
+    const double change = compound_move(st, seed, g, adj_offsets, adjacent, target, params, scratch, flipped);
+    if (change < -1e-9) {
+      ++stats.compounds;
+      applied = true;
+    } else {
+      while (!flipped.empty()) {
+        st.flip(flipped.back().first, -flipped.back().second);
+        flipped.pop_back();
+      }
+    }
+  }
+  return applied;
+}
+
 std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
                                       std::vector<std::uint8_t> y, std::uint64_t target,
                                       const SelectionParams& params, double seconds,
@@ -1182,6 +1303,8 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
     }
     if (params.chain_moves && clock.seconds() < seconds)
       improved |= chain_moves(st, g, gc, target, params, clock, seconds, stats);
+    if (params.compound_moves && !improved && clock.seconds() < seconds)
+      improved = compound_moves(st, g, adj_offsets, adjacent, target, params, clock, seconds, stats);
     if (params.pair_exchanges && !improved && clock.seconds() < seconds)
       improved = pair_exchanges(st, g, target, params, clock, seconds, stats);
   }
@@ -1198,7 +1321,7 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
 // best selection seen is returned. Microseconds per move, so millions of moves fit where the
 // neighbourhood MIPs manage a few hundred; the MIPs then polish its result.
 struct AnnealStats {
-  std::int64_t moves = 0, accepted = 0;
+  std::int64_t moves = 0, accepted = 0, compounds = 0;  // compounds: compound moves accepted
   bool schedule_done = false;  // ended by its move count, not by the time
 };
 
@@ -1225,6 +1348,26 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   std::uint32_t round = 0;
   const double t0 = params.anneal_t0, t1 = params.anneal_t1;
   double temperature = t0;
+  // Penalty continuation (SelectionParams::anneal_count_weight): until the ramp starts the count
+  // term weighs w0 and N' may leave Eq. 2's band by band_relax × the band; over the ramp both go
+  // linearly to the true objective and the hard band, the excess beyond the band penalised by
+  // band_penalty × ramp per triangle-equivalent.
+  const double w0 = params.anneal_count_weight, band_relax = params.anneal_band_relax;
+  const double rho_max = params.anneal_band_penalty;
+  const double count_ramp_start = params.anneal_ramp_start, count_ramp_end = params.anneal_ramp_end;
+  double count_weight = w0;
+  double ramp = 0.0;  // 0 before the ramp, 1 after it
+  auto outside = [&](std::int64_t c) { return std::max(0.0, std::abs(double(c) - n) - band); };
+  auto annealed = [&](double delta, std::int64_t c0, std::int64_t c1) {
+    return delta - (1.0 - count_weight) * (count_term(c1) - count_term(c0)) +
+           rho_max * ramp * (outside(c1) - outside(c0));
+  };
+  // Whether the annealing may go from count c0 to c1.
+  auto allowed = [&](std::int64_t c0, std::int64_t c1) {
+    if (in_band(c1)) return true;
+    if (ramp >= 1.0) return outside(c1) <= outside(c0);
+    return std::abs(double(c1) - n) <= band * (1.0 + band_relax);
+  };
   // The best selection is kept as best_y plus a journal of the groups flipped since: a new best
   // copies only those (a full copy per improvement cost O(groups) each time). A journal longer
   // than the groups falls back to one full copy.
@@ -1241,7 +1384,7 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   auto accept = [&](double delta) {
     ++stats.accepted;
     current += delta;
-    if (current < best - 1e-9) {
+    if (current < best - 1e-9 && in_band(st.count)) {
       best = current;
       if (journal_full) best_y = st.y;
       else
@@ -1265,6 +1408,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       flipped.pop_back();
     }
   };
+  CompoundScratch compound;
+  const double compound_share = params.compound_moves ? params.anneal_compound_share : 0.0;
   // The schedule runs on time or on moves, whichever ends first (small meshes: moves).
   const double max_moves = params.anneal_moves_per_group * double(movable.size());
   for (;; ++stats.moves) {
@@ -1276,20 +1421,38 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       }
       const double progress = std::max(by_time, by_moves);
       temperature = t0 * std::pow(t1 / t0, progress);
+      ramp = progress >= count_ramp_end     ? 1.0
+             : progress <= count_ramp_start ? 0.0
+                                            : (progress - count_ramp_start) / (count_ramp_end - count_ramp_start);
+      count_weight = w0 + (1.0 - w0) * ramp;
     }
     const Index a = movable[rng() % movable.size()];
     const std::int64_t c0 = st.count;
     double rest = 0.0;
     flipped.clear();
+    if (compound_share > 0.0 && unit(rng) < compound_share) {
+      const double delta = compound_move(st, a, g, adj_offsets, adjacent, target, params, compound, flipped);
+      if (!(delta < INFINITY)) continue;  // nothing in the band; the state is unchanged
+      const double da = annealed(delta, c0, st.count);
+      if (da > 0.0 && unit(rng) >= std::exp(-da / temperature)) {
+        undo();
+        continue;
+      }
+      ++stats.compounds;
+      for (const auto& fl : flipped) record(fl.first);
+      accept(delta);
+      continue;
+    }
     const std::uint64_t kind = rng() % 3;
     if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
       // A single flip is judged before it is made: most moves are rejected, and flipping and
       // undoing them costs as much as the evaluation.
       if (st.y[a] && !st.may_collapse(a)) continue;
       const std::int64_t dc = st.delta_count(a);
-      if (!in_band(c0 + dc)) continue;
+      if (!allowed(c0, c0 + dc)) continue;
       const double delta = count_term(c0 + dc) - count_term(c0) + st.delta_rest(a, params);
-      if (delta > 0.0 && unit(rng) >= std::exp(-delta / temperature)) continue;
+      const double da = annealed(delta, c0, c0 + dc);
+      if (da > 0.0 && unit(rng) >= std::exp(-da / temperature)) continue;
       st.flip(a, dc);
       record(a);
       accept(delta);
@@ -1320,7 +1483,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       if (flipped.empty()) continue;
     }
     const double delta = count_term(st.count) - count_term(c0) + rest;
-    if (!in_band(st.count) || (delta > 0.0 && unit(rng) >= std::exp(-delta / temperature))) {
+    const double da = annealed(delta, c0, st.count);
+    if (!allowed(c0, st.count) || (da > 0.0 && unit(rng) >= std::exp(-da / temperature))) {
       undo();
       continue;
     }
@@ -1328,6 +1492,42 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
     accept(delta);
   }
   return best_y;
+}
+
+// Independent annealing chains, one per thread (seeds solve.seed, solve.seed + 1, …), each from
+// the same start for the same time; the selection with the lowest Eq. 9 wins (ties: the lowest
+// seed), so the result does not depend on which thread finishes first. One thread = anneal().
+// On 2 cores this is a best-of-two; it cannot make a chain longer.
+std::vector<std::uint8_t> anneal_chains(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                        std::vector<std::uint8_t> y, std::uint64_t target,
+                                        const SelectionParams& params, double seconds,
+                                        const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
+                                        int chains, AnnealStats& stats) {
+  if (chains <= 1) return anneal(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats);
+  std::vector<std::vector<std::uint8_t>> results(chains);
+  std::vector<AnnealStats> chain_stats(chains);
+  std::vector<std::thread> workers;
+  for (int k = 0; k < chains; ++k)
+    workers.emplace_back([&, k] {
+      SelectionParams p = params;
+      p.solve.seed = params.solve.seed + static_cast<std::uint32_t>(k);
+      results[k] = anneal(g, gc, fg, y, target, p, seconds, adj_offsets, adjacent, chain_stats[k]);
+    });
+  for (std::thread& w : workers) w.join();
+  int best = 0;
+  double best_value = INFINITY;
+  for (int k = 0; k < chains; ++k) {
+    const double value = group_objective(g, gc, fg, results[k], target, params);
+    if (value < best_value) best_value = value, best = k;
+  }
+  stats = {};
+  for (const AnnealStats& cs : chain_stats) {
+    stats.moves += cs.moves;
+    stats.accepted += cs.accepted;
+    stats.compounds += cs.compounds;
+  }
+  stats.schedule_done = chain_stats[best].schedule_done;
+  return std::move(results[best]);
 }
 
 // Groups that share a face, as CSR.
@@ -1576,10 +1776,12 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     if (params.anneal_time_fraction > 0.0 && params.formulation == Formulation::Fast) {
       Stopwatch anneal_clock;
       AnnealStats as;
-      start_y = anneal(groups, gc, fg, std::move(start_y), target, params,
-                       params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent, as);
+      start_y = anneal_chains(groups, gc, fg, std::move(start_y), target, params,
+                              params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent,
+                              ilp::backend::resolve_threads(params.solve), as);
       result.anneal_moves = as.moves;
       result.anneal_accepted = as.accepted;
+      result.anneal_compounds = as.compounds;
       result.anneal_converged = as.schedule_done;
       result.seconds_anneal = anneal_clock.seconds();
     }
@@ -1597,6 +1799,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.swaps = fs.swaps;
     result.exchanges = fs.exchanges;
     result.chains = fs.chains;
+    result.compounds = fs.compounds;
     result.flip_search_converged = fs.converged;
     result.seconds_flip_search = flip_clock.seconds();
   }
@@ -1742,7 +1945,8 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
   group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
   AnnealStats as;
   if (params.anneal_time_fraction > 0.0)
-    p.y = anneal(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as);
+    p.y = anneal_chains(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent,
+                        ilp::backend::resolve_threads(params.solve), as);
   FlipSearchStats stats;
   const std::vector<std::uint8_t> y =
       flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);

@@ -119,6 +119,18 @@ struct SelectionParams {
   /// Chain moves in the local search: runs of consecutive segments of a poly-chord (groups
   /// linked by λ_tri split pairs) flipped as one move (docs/formulation.md, "Speed").
   bool chain_moves = true;
+  /// Compound moves (ejection chains) in the local search and the annealing: flip one group,
+  /// then flip nearby groups the other way, cheapest per triangle-equivalent first, until N' is
+  /// back — e.g. keep one group of an emptied Eq. 6 cluster and collapse small groups around it
+  /// (docs/formulation.md, "Speed").
+  bool compound_moves = true;
+  /// Candidates of one compound move: groups of the other value met by a breadth-first walk over
+  /// groups that share a face from the seed.
+  Index compound_candidates = 32;
+  /// Share of the annealing's moves that are compound moves. Off: each costs ~10–50 single moves,
+  /// and on flightgear_c172p at 0.4, 5 s, shares of 0.02–0.1 were no better than none (single
+  /// runs within the ±100 noise of the load; docs/formulation.md, "Speed").
+  double anneal_compound_share = 0.0;
   /// Simulated annealing from the greedy start, before the local search (fast formulation, a
   /// time limit > 0, greedy in the band): it runs until this fraction of the time limit has
   /// passed since select_edges() began, its temperature falling from anneal_t0 to anneal_t1
@@ -129,6 +141,21 @@ struct SelectionParams {
   double anneal_t1 = 0.05;
   /// The annealing also ends after this many moves per free group (small meshes).
   double anneal_moves_per_group = 1000.0;
+  /// Penalty continuation in the annealing (docs/formulation.md, "Speed"): until anneal_ramp_start
+  /// of its schedule the count term |N' − N| of Eq. 9 weighs anneal_count_weight (1 = as in Eq. 9)
+  /// and N' may leave Eq. 2's band by anneal_band_relax × ϵ_N N; from anneal_ramp_start to
+  /// anneal_ramp_end both go linearly back to Eq. 9 and the hard band (the excess beyond the band
+  /// costs anneal_band_penalty × the ramp's progress per triangle-equivalent); after that, a count
+  /// outside the band may only move toward it. Only selections in the band are kept as the best.
+  /// With the true objective all the way (weight 1, relax 0), the count term's slope and the hard
+  /// band edge block most moves once N' sits on N (c172p) or on the band's edge (cg57).
+  /// Measured at 0.4, 5 s (single runs, load ~5): c172p 2 200–2 400 → 1 740–1 920, cg57
+  /// 95 200–98 300 → 94 300–94 500.
+  double anneal_count_weight = 0.25;
+  double anneal_band_relax = 1.0;
+  double anneal_band_penalty = 4.0;
+  double anneal_ramp_start = 0.6;
+  double anneal_ramp_end = 0.95;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
@@ -179,6 +206,8 @@ struct SelectionResult {
   double seconds_neighbourhood_build = 0.0;  ///< building the neighbourhood models
   double flip_search_objective = 0.0;   ///< Eq. 9 after annealing and the local search (the MIPs' start)
   Index flip_passes = 0, flips = 0, swaps = 0, exchanges = 0, chains = 0;
+  Index compounds = 0;                  ///< compound moves taken by the descent
+  std::int64_t anneal_compounds = 0;    ///< compound moves accepted by the annealing
   double seconds_flip_search = 0.0;
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
   double seconds_anneal = 0.0;

@@ -103,6 +103,8 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"swaps", s.swaps},
       {"exchanges", s.exchanges},
       {"chains", s.chains},
+      {"compounds", s.compounds},
+      {"anneal_compounds", s.anneal_compounds},
       {"seconds_flip_search", s.seconds_flip_search},
       {"anneal_moves", s.anneal_moves},
       {"anneal_accepted", s.anneal_accepted},
