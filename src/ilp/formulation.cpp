@@ -260,12 +260,21 @@ class SelectionState {
   }
 
   /// Change of N' (Eq. 1) if grp flips.
-  std::int64_t delta_count(Index grp) {
+  std::int64_t delta_count(Index grp) const {
+    // One pass: per face, its kept edges S_f now and with grp flipped (grp's multiplicity m added
+    // or removed), t_f = max(0, S_f − 2) of both.
     std::int64_t d = 0;
-    for (Index k = face_offsets_[grp]; k < face_offsets_[grp + 1]; ++k) d -= face_count(fg_, faces_[k], y);
-    y[grp] ^= 1;
-    for (Index k = face_offsets_[grp]; k < face_offsets_[grp + 1]; ++k) d += face_count(fg_, faces_[k], y);
-    y[grp] ^= 1;
+    const std::int64_t sign = y[grp] ? -1 : 1;
+    for (Index k = face_offsets_[grp]; k < face_offsets_[grp + 1]; ++k) {
+      const Index f = faces_[k];
+      std::int64_t kept = 0, m = 0;
+      for (Index i = fg_.offsets[f]; i < fg_.offsets[f + 1]; ++i) {
+        kept += y[fg_.group[i]] * fg_.mult[i];
+        if (fg_.group[i] == grp) m = fg_.mult[i];
+      }
+      const std::int64_t after = kept + sign * m;
+      d += (after > 2 ? after - 2 : 0) - (kept > 2 ? kept - 2 : 0);
+    }
     return d;
   }
   /// Change of Eq. 9 without the count term if grp flips: λ_edge Q, λ_geo when grp is the last
@@ -1446,13 +1455,14 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
     const std::uint64_t kind = rng() % 3;
     if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
       // A single flip is judged before it is made: most moves are rejected, and flipping and
-      // undoing them costs as much as the evaluation.
-      if (st.y[a] && !st.may_collapse(a)) continue;
+      // undoing them costs as much as the evaluation. Eq. 8 is checked last, only for a move
+      // that would be taken (most are not).
       const std::int64_t dc = st.delta_count(a);
       if (!allowed(c0, c0 + dc)) continue;
       const double delta = count_term(c0 + dc) - count_term(c0) + st.delta_rest(a, params);
       const double da = annealed(delta, c0, c0 + dc);
       if (da > 0.0 && unit(rng) >= std::exp(-da / temperature)) continue;
+      if (st.y[a] && !st.may_collapse(a)) continue;
       st.flip(a, dc);
       record(a);
       accept(delta);
