@@ -1797,11 +1797,11 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     }
     Stopwatch flip_clock;
     FlipSearchStats fs;
-    // After annealing the descent only gets what is left up to 90 % of the budget (the
-    // neighbourhood MIPs and building the model need the rest).
+    // After annealing the descent only gets what is left up to descent_end_fraction of the
+    // budget (the neighbourhood MIPs get the rest).
     const double flip_budget =
         result.anneal_moves > 0
-            ? std::min(params.flip_search_time_fraction * time_limit, std::max(0.0, 0.9 * time_limit - clock.seconds()))
+            ? std::min(params.flip_search_time_fraction * time_limit, std::max(0.0, params.descent_end_fraction * time_limit - clock.seconds()))
             : params.flip_search_time_fraction * time_limit;
     start_y = flip_search(groups, gc, fg, std::move(start_y), target, params, flip_budget, adj_offsets, adjacent, fs);
     result.flip_passes = fs.passes;
