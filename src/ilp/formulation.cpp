@@ -32,7 +32,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numeric>
 #include <optional>
 #include <queue>
@@ -308,13 +307,6 @@ class SelectionState {
     for (Index cl : gc_.group_tri[grp]) tri_collapsed_[cl] += collapse ? 1 : Index(-1);
   }
 
-  /// Whether grp (collapsed) lies in an Eq. 6 cluster with every group collapsed.
-  bool in_emptied_cluster(Index grp) const {
-    for (Index cl : gc_.group_geo[grp])
-      if (geo_kept_[cl] == 0) return true;
-    return false;
-  }
-
   std::vector<std::uint8_t> y;
   std::int64_t count = 0;
 
@@ -346,10 +338,9 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
   };
   std::priority_queue<Entry> heap;
   // Key: cost per removed triangle-equivalent of collapsing a kept group.
-  auto key_of = [&](Index grp, std::int64_t d) { return st.delta_rest(grp, params) / double(d); };
   auto push = [&](Index grp) {
     const std::int64_t d = -st.delta_count(grp);
-    if (d > 0) heap.push({key_of(grp, d), grp, d});
+    if (d > 0) heap.push({st.delta_rest(grp, params) / double(d), grp, d});
   };
   for (Index grp = 0; grp < g.count; ++grp)
     if (!g.fixed[grp]) push(grp);
@@ -365,7 +356,7 @@ GreedyResult greedy_select(const Groups& g, const GroupConstraints& gc, const Fa
     if (!st.y[top.group]) continue;
     const std::int64_t d = -st.delta_count(top.group);
     if (d <= 0) continue;
-    const double key = key_of(top.group, d);
+    const double key = st.delta_rest(top.group, params) / double(d);
     if (d != top.delta || key != top.key) {  // stale entry: its neighbours changed
       heap.push({key, top.group, d});
       continue;
@@ -1151,8 +1142,9 @@ bool pair_exchanges(SelectionState& st, const Groups& g, std::uint64_t target, c
 // chord is tens of triangle-equivalents, far more than λ_geo, so the single flip and the pair
 // exchanges rarely pay), and several small groups around it, collapsed, remove those faces again
 // without emptying another cluster. The reverse (collapse a large group, keep small ones around
-// it) comes with the same code. Candidates: the groups of the other value within a breadth-first
-// walk over groups that share a face, up to `compound_candidates`. The prefix of the chain with the
+// it) comes with the same code. Candidates: groups that now hold the seed's new value (so they flip
+// the other way), met by a breadth-first walk over groups that share a face, up to
+// `compound_candidates`. The prefix of the chain with the
 // best Eq. 9 change inside Eq. 2's band is kept (its flips are in `flipped`); the rest is undone.
 // Returns that change, or +∞ with the state unchanged when no prefix lies in the band.
 //
