@@ -40,7 +40,9 @@ def main():
     ap.add_argument("--formulations", default="fast,exact")
     ap.add_argument("--limits", default="5,180", help="comma-separated --time-limit values, seconds")
     ap.add_argument("--out", default="/tmp/quadlod_selection_quality", help="reports and outputs")
-    ap.add_argument("--tag", default="", help="suffix of the report names (to keep variants apart)")
+    ap.add_argument("--tag", default="", help="suffix of the report names (to keep variants apart); "
+                    "comma-separated to tabulate several variants together, e.g. ',_v2' (the best "
+                    "of a mesh is then the best of every variant)")
     ap.add_argument("--skip-missing", action="store_true", help="tabulate existing reports, run nothing")
     ap.add_argument("extra", nargs="*", help="more simplify arguments, after --")
     a = ap.parse_args()
@@ -55,8 +57,8 @@ def main():
         src = os.path.join(a.corpus, mesh + ".obj")
         for ratio in a.ratios.split(","):
             for form in a.formulations.split(","):
-                for limit in a.limits.split(","):
-                    name = f"{mesh}_r{ratio}_{form}_t{limit}{a.tag}"
+                for limit, tag in [(l, t) for t in a.tag.split(",") for l in a.limits.split(",")]:
+                    name = f"{mesh}_r{ratio}_{form}_t{limit}{tag}"
                     report = os.path.join(a.out, name + ".json")
                     meta = os.path.join(a.out, name + ".load")
                     if not os.path.exists(report) and a.skip_missing:
@@ -73,14 +75,15 @@ def main():
                             f.write(f"{load} {time.time() - t:.2f}\n")
                     load = open(meta).read().split()[0] if os.path.exists(meta) else "?"
                     s = json.load(open(report))["selection"]
-                    rows.append(dict(mesh=mesh, ratio=ratio, form=form, limit=limit, load=load, s=s))
+                    rows.append(dict(mesh=mesh, ratio=ratio, form=form, limit=limit, tag=tag, load=load, s=s))
     best = {}
     for r in rows:
         key = (r["mesh"], r["ratio"])
         best[key] = min(best.get(key, float("inf")), r["s"]["objective"])
-    print("| mesh | formulation | limit s | rows | cols | presolved rows | presolved cols | objective | baseline | above best | gap to best "
+    variants = "," in a.tag
+    print("| mesh | " + ("variant | " if variants else "") + "formulation | limit s | rows | cols | presolved rows | presolved cols | objective | baseline | above best | gap to best "
           "| proven gap | N' / N | select s | stop | t best s | neighbourhoods | load |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---" * (19 if variants else 18) + "|")
     for r in rows:
         s = r["s"]
         b = best[(r["mesh"], r["ratio"])]
@@ -92,7 +95,8 @@ def main():
         pr = solver.get("presolved_rows", -1) if whole else -1
         pc = solver.get("presolved_cols", -1) if whole else -1
         tb = f"{solver.get('seconds_to_best', 0):.1f}" if whole and solver.get("seconds_to_best") else "–"
-        print(f"| {r['mesh']} | {r['form']} | {r['limit']} | {s['formulation_rows']} "
+        variant = f"{r['tag'] or '–'} | " if variants else ""
+        print(f"| {r['mesh']} | {variant}{r['form']} | {r['limit']} | {s['formulation_rows']} "
               f"| {s['formulation_cols']} | {pr if pr >= 0 else '–'} | {pc if pc >= 0 else '–'} "
               f"| {s['objective']:.1f} | {s['baseline_objective']:.1f} | {s['objective'] - b:.1f} | {gap:.2f} % | {proven} | {s['predicted']} / {s['target']} "
               f"| {s['seconds']:.2f} | {s.get('stop_reason', '?')} | {tb} | {s.get('neighbourhoods', 0)} | {r['load']} |")
