@@ -608,6 +608,37 @@ TEST(ClusterCollapseFeatures, MergedVerticesStayOnTheSeamAndGetTheUvOfTheirSide)
   EXPECT_EQ(p.stats.uv_values_projected, 0u);
 }
 
+// The provenance behind simplify's island accounting: grid(6, 4) with column 2 its own UV island
+// (one face wide). Collapsing that column's chord without feature rules drops its four faces:
+// face_source maps every output face to its input face, and the accounting finds the island
+// vanished (4 faces, area 1/6) and the two others whole.
+TEST(ClusterCollapseFeatures, FaceSourceTracksInputFacesAndAccountsAVanishedIsland) {
+  const Index n = 6, m = 4;
+  const PolyMesh in =
+      feature_test::grid_with_face_uvs(n, m, [&](Index f) { return f % n == 2 ? 2.0 : f % n > 2 ? 4.0 : 0.0; });
+  const Connectivity conn = build_connectivity(in);
+  ClusterCollapseParams plain;
+  plain.respect_features = false;
+  const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, column_chord(n, m, 2)), plain);
+  expect_valid_output(in, r);
+  ASSERT_EQ(r.face_source.size(), r.mesh.num_faces());
+  ASSERT_EQ(r.mesh.num_faces(), (n - 1) * m);
+  for (Index f = 0; f < r.mesh.num_faces(); ++f) {
+    const Index src = r.face_source[f];
+    EXPECT_NE(src % n, 2u) << "face " << f;  // the collapsed column left nothing
+    const Index row = f / (n - 1), t = f % (n - 1);
+    EXPECT_EQ(src, row * n + (t < 2 ? t : t + 1));  // input order, column 2 skipped
+  }
+  const UvIslandAccount a = account_uv_islands(in, r.mesh, r.face_source);
+  EXPECT_EQ(a.in, 3u);
+  EXPECT_EQ(a.out, 2u);
+  EXPECT_EQ(a.vanished, 1u);
+  EXPECT_EQ(a.merged + a.split, 0u);
+  ASSERT_EQ(a.vanished_islands.size(), 1u);
+  EXPECT_EQ(a.vanished_islands[0].faces, m);
+  EXPECT_NEAR(a.vanished_islands[0].area, 1.0 / n, 1e-12);
+}
+
 // A single column of material "B" between two columns of "A": collapsing its chord would make
 // the two A|B borders one A|A non-border — refused as `feature`, and nothing collapses.
 TEST(ClusterCollapseFeatures, ClusterJoiningTwoMaterialBordersIsRefused) {

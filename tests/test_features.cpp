@@ -322,3 +322,106 @@ TEST(Features, NonManifoldEdgeCarriesItsOwnBit) {
   // Spine ends: valence 4 (the spine and three page edges): corners; page corners turn 90°.
   EXPECT_EQ(f.fe.corners, 8u);
 }
+
+// --- exact island accounting from provenance (account_uv_islands) ---------------------------------
+
+namespace {
+std::vector<Index> identity_origin(const PolyMesh& m) {
+  std::vector<Index> o(m.num_faces());
+  for (Index f = 0; f < m.num_faces(); ++f) o[f] = f;
+  return o;
+}
+// out = in − vanished + split_extra − merged_reduction + appeared, the identity the report keeps.
+void expect_balanced(const UvIslandAccount& a) {
+  EXPECT_EQ(std::int64_t(a.out), std::int64_t(a.in) - a.vanished + a.split_extra - a.merged_reduction + a.appeared);
+}
+}  // namespace
+
+TEST(UvIslandAccount, UnchangedMeshKeepsEveryIsland) {
+  const PolyMesh g = grid_with_seam_column(4, 2, 2, 0.5);
+  const UvIslandAccount a = account_uv_islands(g, g, identity_origin(g));
+  EXPECT_EQ(a.in, 2u);
+  EXPECT_EQ(a.out, 2u);
+  EXPECT_EQ(a.vanished + a.merged + a.split + a.appeared, 0u);
+  expect_balanced(a);
+}
+
+// grid(3, 1), one island. The output is the same mesh with face 2's UVs shifted: a seam between
+// faces 1 and 2 that the input did not have, so the input island lies in two output islands.
+TEST(UvIslandAccount, NewSeamInsideAnIslandIsOneSplit) {
+  const PolyMesh in = make_grid(3, 1);
+  PolyMesh out = in;
+  UvSet& uv = out.uv_sets[0];
+  for (Index c = out.face_begin(2); c < out.face_end(2); ++c) {
+    uv.values.push_back(uv.values[uv.corner[c]] + Vec2(2.0, 0.0));
+    uv.corner[c] = static_cast<Index>(uv.values.size() - 1);
+  }
+  const UvIslandAccount a = account_uv_islands(in, out, identity_origin(out));
+  EXPECT_EQ(a.in, 1u);
+  EXPECT_EQ(a.out, 2u);
+  EXPECT_EQ(a.split, 1u);
+  EXPECT_EQ(a.split_extra, 1u);
+  EXPECT_EQ(a.merged + a.vanished, 0u);
+  ASSERT_EQ(a.split_islands.size(), 1u);
+  EXPECT_EQ(a.split_islands[0].first, 0u);
+  EXPECT_EQ(a.split_islands[0].second, (std::vector<Index>{0, 1}));
+  expect_balanced(a);
+}
+
+// grid_with_seam_column(2, 1, 1, 0.5): two faces, two islands. The output gives the right face
+// the left chart's UVs (the seam is gone): one output island with faces from both → merged.
+TEST(UvIslandAccount, SeamThatDisappearsIsOneMerge) {
+  const PolyMesh in = grid_with_seam_column(2, 1, 1, 0.5);
+  const PolyMesh out = make_grid(2, 1);
+  const UvIslandAccount a = account_uv_islands(in, out, identity_origin(out));
+  EXPECT_EQ(a.in, 2u);
+  EXPECT_EQ(a.out, 1u);
+  EXPECT_EQ(a.merged, 1u);
+  EXPECT_EQ(a.merged_reduction, 1u);
+  EXPECT_EQ(a.split + a.vanished, 0u);
+  ASSERT_EQ(a.merged_islands.size(), 1u);
+  EXPECT_EQ(a.merged_islands[0].second, (std::vector<Index>{0, 1}));
+  expect_balanced(a);
+}
+
+// Three column islands of grid(6, 2) (columns 0–1, 2, 3–5); an output that keeps only the faces
+// of the outer islands (origins say which) loses the middle one: 1 vanished, 2 faces of area 1/6,
+// i.e. below one output face when the output's faces are larger.
+TEST(UvIslandAccount, IslandWithoutSurvivingFacesVanishesWithItsSize) {
+  const PolyMesh in = feature_test::grid_with_face_uvs(6, 2, [](Index f) { return f % 6 == 2 ? 2.0 : f % 6 > 2 ? 4.0 : 0.0; });
+  // Output: one big quad per outer island (origins: an input face of that island), face 1 in a
+  // chart of its own.
+  PolyMesh out = make_grid(2, 1);
+  for (Index c = out.face_begin(1); c < out.face_end(1); ++c) {
+    out.uv_sets[0].values.push_back(out.uv_sets[0].values[out.uv_sets[0].corner[c]] + Vec2(4.0, 0.0));
+    out.uv_sets[0].corner[c] = static_cast<Index>(out.uv_sets[0].values.size() - 1);
+  }
+  const UvIslandAccount a = account_uv_islands(in, out, {0, 5});
+  EXPECT_EQ(a.in, 3u);
+  EXPECT_EQ(a.out, 2u);
+  EXPECT_EQ(a.vanished, 1u);
+  EXPECT_EQ(a.merged + a.split, 0u);
+  ASSERT_EQ(a.vanished_islands.size(), 1u);
+  EXPECT_EQ(a.vanished_islands[0].island, 1u);
+  EXPECT_EQ(a.vanished_islands[0].faces, 2u);
+  EXPECT_NEAR(a.vanished_islands[0].area, 1.0 / 6, 1e-12);
+  EXPECT_NEAR(a.vanished_islands[0].output_faces, (1.0 / 6) / 0.5, 1e-12);
+  EXPECT_EQ(a.vanished_below_one_face, 1u);
+  expect_balanced(a);
+}
+
+// Merge and split at once: input islands A (faces 0, 1) and B (2, 3) of grid(4, 1); the output
+// cuts between 0|1 and 2|3 and joins 1–2: output islands {0}, {1, 2}, {3}. A splits (0 | 1), B
+// splits (2 | 3), {1, 2} merges A and B: out 3 = 2 − 0 + 2 − 1.
+TEST(UvIslandAccount, MergeAndSplitTogetherStayBalanced) {
+  const PolyMesh in = feature_test::grid_with_face_uvs(4, 1, [](Index f) { return f < 2 ? 0.0 : 3.0; });
+  const PolyMesh out = feature_test::grid_with_face_uvs(4, 1, [](Index f) { return f == 0 ? 0.0 : f == 3 ? 6.0 : 3.0; });
+  const UvIslandAccount a = account_uv_islands(in, out, identity_origin(out));
+  EXPECT_EQ(a.in, 2u);
+  EXPECT_EQ(a.out, 3u);
+  EXPECT_EQ(a.split, 2u);
+  EXPECT_EQ(a.split_extra, 2u);
+  EXPECT_EQ(a.merged, 1u);
+  EXPECT_EQ(a.merged_reduction, 1u);
+  expect_balanced(a);
+}

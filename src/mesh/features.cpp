@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cmath>
 #include <limits>
 #include <numbers>
 
@@ -289,6 +290,76 @@ UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index 
     r.area_3d[id] += face_area_vector(mesh, f).norm();
   }
   return r;
+}
+
+}  // namespace quadlod
+
+namespace quadlod {
+
+UvIslandAccount account_uv_islands(const PolyMesh& input, const PolyMesh& output,
+                                   const std::vector<Index>& face_origin, Index uv_set) {
+  UvIslandAccount acc;
+  const UvIslands in = find_uv_islands(input, build_connectivity(input), uv_set);
+  const UvIslands out = find_uv_islands(output, build_connectivity(output), uv_set);
+  auto counted = [](const UvIslands& isl, Index f) {
+    const Index i = isl.face_island[f];
+    return i != kInvalidIndex && isl.area_3d[i] > 0.0 ? i : kInvalidIndex;
+  };
+  for (double a : in.area_3d) acc.in += a > 0.0;
+  for (double a : out.area_3d) acc.out += a > 0.0;
+  // Links (input island, output island), one per pair.
+  std::vector<std::pair<Index, Index>> links;
+  for (Index f = 0; f < output.num_faces(); ++f) {
+    const Index o = counted(out, f);
+    const Index src = f < face_origin.size() ? face_origin[f] : kInvalidIndex;
+    if (o == kInvalidIndex || src == kInvalidIndex) continue;
+    const Index i = counted(in, src);
+    if (i != kInvalidIndex) links.emplace_back(i, o);
+  }
+  std::sort(links.begin(), links.end());
+  links.erase(std::unique(links.begin(), links.end()), links.end());
+  std::vector<std::vector<Index>> outs_of(in.num_islands), ins_of(out.num_islands);
+  for (const auto& [i, o] : links) {
+    outs_of[i].push_back(o);
+    ins_of[o].push_back(i);
+  }
+  double output_area = 0.0;
+  Index output_faces = 0;
+  for (Index f = 0; f < output.num_faces(); ++f) {
+    output_area += face_area_vector(output, f).norm();
+    ++output_faces;
+  }
+  const double mean_face_area = output_faces > 0 ? output_area / double(output_faces) : 0.0;
+  std::vector<Index> faces_of(in.num_islands, 0);
+  for (Index f = 0; f < input.num_faces(); ++f)
+    if (in.face_island[f] != kInvalidIndex) ++faces_of[in.face_island[f]];
+  for (Index i = 0; i < in.num_islands; ++i) {
+    if (!(in.area_3d[i] > 0.0)) continue;
+    if (outs_of[i].empty()) {
+      UvIslandAccount::Vanished v;
+      v.island = i;
+      v.faces = faces_of[i];
+      v.area = in.area_3d[i];
+      v.output_faces = mean_face_area > 0.0 ? v.area / mean_face_area : INFINITY;
+      acc.vanished_below_one_face += v.output_faces < 1.0;
+      acc.vanished_islands.push_back(v);
+    } else if (outs_of[i].size() > 1) {
+      acc.split_extra += static_cast<Index>(outs_of[i].size()) - 1;
+      acc.split_islands.emplace_back(i, outs_of[i]);
+    }
+  }
+  for (Index o = 0; o < out.num_islands; ++o) {
+    if (!(out.area_3d[o] > 0.0)) continue;
+    if (ins_of[o].empty()) ++acc.appeared;
+    else if (ins_of[o].size() > 1) {
+      acc.merged_reduction += static_cast<Index>(ins_of[o].size()) - 1;
+      acc.merged_islands.emplace_back(o, ins_of[o]);
+    }
+  }
+  acc.vanished = static_cast<Index>(acc.vanished_islands.size());
+  acc.merged = static_cast<Index>(acc.merged_islands.size());
+  acc.split = static_cast<Index>(acc.split_islands.size());
+  return acc;
 }
 
 }  // namespace quadlod

@@ -111,3 +111,44 @@ struct UvIslands {
 UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index uv_set);
 
 }  // namespace quadlod
+
+namespace quadlod {
+
+/// Exact UV island accounting of a reduction from its provenance (issue 7; docs/attributes.md,
+/// "Island accounting"). `quadlod eval` has to guess which input island an output face belongs
+/// to from geometry (docs/metrics.md §6c); the pipeline knows: every output face comes from one
+/// input face. Islands are those of find_uv_islands with positive 3D area, as eval counts them.
+/// An input island and an output island are *linked* when an output face of the output island
+/// comes from an input face of the input island. Then, with deg = number of links,
+///   vanished = input islands without links,
+///   merged   = output islands with deg >= 2 (merged_reduction = Σ (deg − 1) over them),
+///   split    = input islands with deg >= 2 (split_extra = Σ (deg − 1) over them),
+///   appeared = output islands without links (from faces whose input island had no area),
+/// and out = in − vanished + split_extra − merged_reduction + appeared holds by construction
+/// (both sides count the links).
+struct UvIslandAccount {
+  Index in = 0, out = 0;
+  Index vanished = 0, merged = 0, split = 0, appeared = 0;
+  Index split_extra = 0, merged_reduction = 0;
+  /// Vanished input islands whose 3D area is below the mean output face area: too small for
+  /// even one output face (the issue's "whole islands vanish below one face").
+  Index vanished_below_one_face = 0;
+  struct Vanished {
+    Index island = 0;      ///< input island id (find_uv_islands numbering of the input)
+    Index faces = 0;       ///< its input faces
+    double area = 0.0;     ///< its 3D area
+    double output_faces = 0.0;  ///< area / mean output face area
+  };
+  std::vector<Vanished> vanished_islands;
+  /// Output islands with faces from several input islands, each with the input islands.
+  std::vector<std::pair<Index, std::vector<Index>>> merged_islands;
+  /// Input islands whose surviving faces lie in several output islands, each with those.
+  std::vector<std::pair<Index, std::vector<Index>>> split_islands;
+};
+
+/// Precondition: face_origin.size() == output.num_faces(), each entry a face of `input` (or
+/// kInvalidIndex: no origin), uv_set exists in both meshes.
+UvIslandAccount account_uv_islands(const PolyMesh& input, const PolyMesh& output,
+                                   const std::vector<Index>& face_origin, Index uv_set = 0);
+
+}  // namespace quadlod

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <numeric>
 #include <optional>
 
 namespace quadlod {
@@ -152,6 +153,7 @@ namespace {
 struct PassOutcome {
   std::string error;
   PolyMesh mesh;
+  std::vector<Index> face_source;  // output face → input face of this pass (provenance)
   nlohmann::json report;  // analysis, features, selection, dual_repair, collapse, rounds, stage_seconds
   std::string note;       // the selection's "nothing to do", when that is what happened
   std::uint64_t input_tri_equivalent = 0;
@@ -379,6 +381,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
                              {"dual", out.seconds_dual},
                              {"collapse", out.seconds_collapse}};
   out.mesh = std::move(best->mesh);
+  out.face_source = std::move(best->face_source);
   out.achieved = tri_equivalent_count(out.mesh);
   return out;
 }
@@ -466,6 +469,9 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   }
   PolyMesh current;
   const PolyMesh* pass_input = &input;
+  // Output face → original input face, composed over the passes (exact island accounting).
+  std::vector<Index> face_origin(input.num_faces());
+  std::iota(face_origin.begin(), face_origin.end(), Index{0});
   PassOutcome last;
   nlohmann::json passes = nlohmann::json::array();
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
@@ -494,6 +500,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     const bool improved = pass <= planned || outcome.achieved < last.achieved;
     if (!improved) break;  // an extra pass that does not get closer is dropped
     last = std::move(outcome);
+    for (Index& f : last.face_source) f = face_origin[f];
+    face_origin = std::move(last.face_source);
     current = std::move(last.mesh);
     pass_input = &current;
     if (pass >= planned &&
@@ -546,6 +554,28 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
                     static_cast<unsigned long long>(result.target), result.passes_used,
                     static_cast<unsigned>(last.refusals));
     result.note = text;
+  }
+  // UV islands, exactly, from provenance (docs/attributes.md, "Island accounting").
+  if (!input.uv_sets.empty() && !result.mesh.uv_sets.empty() && face_origin.size() == result.mesh.num_faces()) {
+    const UvIslandAccount acc = account_uv_islands(input, result.mesh, face_origin);
+    nlohmann::json vanished = nlohmann::json::array(), merged = nlohmann::json::array(),
+                   split = nlohmann::json::array();
+    for (const auto& v : acc.vanished_islands)
+      vanished.push_back({{"island", v.island}, {"faces", v.faces}, {"area", v.area}, {"output_faces", v.output_faces}});
+    for (const auto& [o, ins] : acc.merged_islands) merged.push_back({{"output_island", o}, {"input_islands", ins}});
+    for (const auto& [i, outs] : acc.split_islands) split.push_back({{"input_island", i}, {"output_islands", outs}});
+    report["uv_islands"] = {{"in", acc.in},
+                            {"out", acc.out},
+                            {"vanished", acc.vanished},
+                            {"vanished_below_one_face", acc.vanished_below_one_face},
+                            {"merged", acc.merged},
+                            {"split", acc.split},
+                            {"appeared", acc.appeared},
+                            {"split_extra", acc.split_extra},
+                            {"merged_reduction", acc.merged_reduction},
+                            {"vanished_islands", std::move(vanished)},
+                            {"merged_islands", std::move(merged)},
+                            {"split_islands", std::move(split)}};
   }
   report["input_tri_equivalent"] = result.input_tri_equivalent;
   report["target"] = result.target;

@@ -1264,6 +1264,7 @@ void Collapser::assemble(const std::vector<std::uint8_t>& edge_kept, ClusterColl
         if (normals) om.corner_normal.push_back(normal_of(c));
       }
       om.face_offsets.push_back(static_cast<Index>(om.corner_vertex.size()));
+      out.face_source.push_back(f);
       if (tag_o) om.face_object.push_back(mesh_.face_object[f]);
       if (tag_g) om.face_group.push_back(mesh_.face_group[f]);
       if (tag_m) om.face_material.push_back(mesh_.face_material[f]);
@@ -1544,6 +1545,8 @@ ClusterCollapseResult collapse_clusters(const PolyMesh& mesh, const Connectivity
     result.vertex_map.resize(mesh.num_vertices());
     std::iota(result.vertex_map.begin(), result.vertex_map.end(), Index{0});
     result.edge_collapsed_final.assign(conn.num_edges, 0);
+    result.face_source.resize(mesh.num_faces());
+    std::iota(result.face_source.begin(), result.face_source.end(), Index{0});
     result.stats.faces_in = result.stats.faces_out = mesh.num_faces();
     result.seconds = clock.seconds();
     return result;

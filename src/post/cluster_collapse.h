@@ -249,6 +249,9 @@ struct ClusterCollapseResult {
   /// One per input (Connectivity) edge: 1 when its endpoints ended in the same output vertex
   /// (collapsed), 0 when the edge survives. Note the inversion w.r.t. the `edge_kept` input.
   std::vector<std::uint8_t> edge_collapsed_final;
+  /// Output face → the input face it comes from (a pinched input face gives several output
+  /// faces, a dropped one none). The provenance behind simplify's exact UV island accounting.
+  std::vector<Index> face_source;
   ClusterCollapseStats stats;
   double seconds = 0.0;
 };
