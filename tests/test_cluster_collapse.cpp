@@ -639,6 +639,77 @@ TEST(ClusterCollapseFeatures, FaceSourceTracksInputFacesAndAccountsAVanishedIsla
   EXPECT_NEAR(a.vanished_islands[0].area, 1.0 / n, 1e-12);
 }
 
+// A closed part without any strict feature line (one UV island, no boundary, no seam: an
+// eyeball) whose every edge is collapsed would vanish whole, texture and all. The island keeps a
+// face: the cluster is refused as `island` (split until a face survives). With the
+// protection off (min_kept_island_area < 0) the cube is gone.
+TEST(ClusterCollapseFeatures, IslandDoesNotVanishWhole) {
+  PolyMesh in = make_cube(1);
+  in.uv_sets.assign(1, UvSet{});
+  for (const Vec3& p : in.positions) in.uv_sets[0].values.push_back(Vec2(p.x() + 0.5 * p.z(), p.y() + 0.25 * p.z()));
+  in.uv_sets[0].corner = in.corner_vertex;  // one value per vertex: no seam, one island
+  const Connectivity conn = build_connectivity(in);
+  ASSERT_EQ(find_uv_islands(in, conn, 0).num_islands, 1u);
+  const std::vector<std::uint8_t> none_kept(conn.num_edges, 0);
+
+  ClusterCollapseParams off;
+  off.min_kept_island_area = -1.0;
+  const ClusterCollapseResult gone = collapse_clusters(in, conn, none_kept, off);
+  EXPECT_EQ(gone.mesh.num_faces(), 0u);
+
+  const ClusterCollapseResult kept = collapse_clusters(in, conn, none_kept);
+  expect_valid_output(in, kept);
+  EXPECT_GE(kept.mesh.num_faces(), 1u);
+  EXPECT_GE(kept.stats.refusals(CollapseRefusal::Island), 1u);
+  EXPECT_EQ(find_uv_islands(kept.mesh, build_connectivity(kept.mesh), 0).num_islands, 1u);
+  // An island smaller than the bound may vanish (6 unit faces: area 6).
+  ClusterCollapseParams small;
+  small.min_kept_island_area = 7.0;
+  EXPECT_EQ(collapse_clusters(in, conn, none_kept, small).mesh.num_faces(), 0u);
+}
+
+// A thin tube (4 quads around, 3 along, one UV island without seams: one value per vertex) whose
+// two inner rings each collapse to a point becomes two cones; the band of faces between them is
+// dropped. No new boundary, no non-manifold vertex: only the island check sees that the island
+// fell apart (cg57's thin tubes at 0.4). Refused as `island`: the output island stays in one piece.
+TEST(ClusterCollapseFeatures, IslandIsNotCutInTwo) {
+  const Index n = 4, m = 3;
+  PolyMesh in = make_cylinder(n, m, 0.05, 3.0);
+  in.uv_sets.assign(1, UvSet{});
+  for (const Vec3& p : in.positions) in.uv_sets[0].values.push_back(Vec2(p.x() + p.y(), p.z()));
+  in.uv_sets[0].corner = in.corner_vertex;
+  const Connectivity conn = build_connectivity(in);
+  ASSERT_EQ(find_uv_islands(in, conn, 0).num_islands, 1u);
+  // Ring edges of the two inner rings (z = 1 and z = 2) collapsed.
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  Index ring_edges = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const Vec3& a = in.positions[conn.edge_vertices[e][0]];
+    const Vec3& b = in.positions[conn.edge_vertices[e][1]];
+    if (std::abs(a.z() - b.z()) < 1e-9 && (std::abs(a.z() - 1.0) < 1e-9 || std::abs(a.z() - 2.0) < 1e-9)) {
+      kept[e] = 0;
+      ++ring_edges;
+    }
+  }
+  ASSERT_EQ(ring_edges, 2 * n);
+  auto output_islands = [](const PolyMesh& m) { return find_uv_islands(m, build_connectivity(m), 0).num_islands; };
+
+  ClusterCollapseParams off;
+  off.min_kept_island_area = -1.0;
+  const ClusterCollapseResult cut = collapse_clusters(in, conn, kept, off);
+  expect_valid_output(in, cut);
+  EXPECT_EQ(cut.mesh.num_faces(), 2 * n);  // two cones of n triangles
+  EXPECT_EQ(output_islands(cut.mesh), 2u);
+  EXPECT_EQ(account_uv_islands(in, cut.mesh, cut.face_source).split, 1u);
+
+  const ClusterCollapseResult r = collapse_clusters(in, conn, kept);
+  expect_valid_output(in, r);
+  EXPECT_GE(r.stats.refusals(CollapseRefusal::Island), 1u);
+  EXPECT_EQ(output_islands(r.mesh), 1u);
+  EXPECT_EQ(account_uv_islands(in, r.mesh, r.face_source).split, 0u);
+  EXPECT_GT(r.mesh.num_faces(), 0u);
+}
+
 // A single column of material "B" between two columns of "A": collapsing its chord would make
 // the two A|B borders one A|A non-border — refused as `feature`, and nothing collapses.
 TEST(ClusterCollapseFeatures, ClusterJoiningTwoMaterialBordersIsRefused) {

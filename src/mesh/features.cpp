@@ -297,7 +297,7 @@ UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index 
 namespace quadlod {
 
 UvIslandAccount account_uv_islands(const PolyMesh& input, const PolyMesh& output,
-                                   const std::vector<Index>& face_origin, Index uv_set) {
+                                   const std::vector<Index>& face_origin, Index uv_set, double one_face_area) {
   UvIslandAccount acc;
   const UvIslands in = find_uv_islands(input, build_connectivity(input), uv_set);
   const UvIslands out = find_uv_islands(output, build_connectivity(output), uv_set);
@@ -329,7 +329,8 @@ UvIslandAccount account_uv_islands(const PolyMesh& input, const PolyMesh& output
     output_area += face_area_vector(output, f).norm();
     ++output_faces;
   }
-  const double mean_face_area = output_faces > 0 ? output_area / double(output_faces) : 0.0;
+  const double mean_face_area =
+      one_face_area > 0.0 ? one_face_area : output_faces > 0 ? output_area / double(output_faces) : 0.0;
   std::vector<Index> faces_of(in.num_islands, 0);
   for (Index f = 0; f < input.num_faces(); ++f)
     if (in.face_island[f] != kInvalidIndex) ++faces_of[in.face_island[f]];

@@ -130,14 +130,14 @@ struct UvIslandAccount {
   Index in = 0, out = 0;
   Index vanished = 0, merged = 0, split = 0, appeared = 0;
   Index split_extra = 0, merged_reduction = 0;
-  /// Vanished input islands whose 3D area is below the mean output face area: too small for
-  /// even one output face (the issue's "whole islands vanish below one face").
+  /// Vanished input islands whose 3D area is below one output face (`one_face_area`): too small
+  /// to keep even one face (the issue's "whole islands vanish below one face").
   Index vanished_below_one_face = 0;
   struct Vanished {
     Index island = 0;      ///< input island id (find_uv_islands numbering of the input)
     Index faces = 0;       ///< its input faces
     double area = 0.0;     ///< its 3D area
-    double output_faces = 0.0;  ///< area / mean output face area
+    double output_faces = 0.0;  ///< area / one_face_area: how many output faces it was worth
   };
   std::vector<Vanished> vanished_islands;
   /// Output islands with faces from several input islands, each with the input islands.
@@ -147,8 +147,11 @@ struct UvIslandAccount {
 };
 
 /// Precondition: face_origin.size() == output.num_faces(), each entry a face of `input` (or
-/// kInvalidIndex: no origin), uv_set exists in both meshes.
+/// kInvalidIndex: no origin), uv_set exists in both meshes. one_face_area: the area of "one
+/// output face" (simplify passes input area / target tri-equivalents, the bound its collapse
+/// protects islands from; <= 0: the output's mean face area).
 UvIslandAccount account_uv_islands(const PolyMesh& input, const PolyMesh& output,
-                                   const std::vector<Index>& face_origin, Index uv_set = 0);
+                                   const std::vector<Index>& face_origin, Index uv_set = 0,
+                                   double one_face_area = 0.0);
 
 }  // namespace quadlod

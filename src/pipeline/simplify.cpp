@@ -439,6 +439,15 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
   cp.features.hard_angle_deg = options.hard_angle_deg;
+  // Islands big enough for one output face must keep one (issue 7): the smallest area an output
+  // face can have on average, the input's area over the target's tri-equivalents.
+  {
+    double area = 0.0;
+    for (Index f = 0; f < input.num_faces(); ++f) area += face_area_vector(input, f).norm();
+    const double target = options.target_tri_equivalent > 0 ? double(options.target_tri_equivalent)
+                                                             : options.ratio * double(tri_equivalent_count(input));
+    cp.min_kept_island_area = target > 0.0 ? area / target : 0.0;
+  }
 
   // Passes (beyond the paper). One global selection can remove only so much: at 20 % of a
   // low-poly character, the clusters of one selection grow so large that the collapse refuses
@@ -557,7 +566,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   }
   // UV islands, exactly, from provenance (docs/attributes.md, "Island accounting").
   if (!input.uv_sets.empty() && !result.mesh.uv_sets.empty() && face_origin.size() == result.mesh.num_faces()) {
-    const UvIslandAccount acc = account_uv_islands(input, result.mesh, face_origin);
+    const UvIslandAccount acc = account_uv_islands(input, result.mesh, face_origin, 0, cp.min_kept_island_area);
     nlohmann::json vanished = nlohmann::json::array(), merged = nlohmann::json::array(),
                    split = nlohmann::json::array();
     for (const auto& v : acc.vanished_islands)

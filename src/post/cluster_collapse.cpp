@@ -134,6 +134,20 @@ class Collapser {
   std::vector<VertexTerms> terms_;
   std::vector<std::int8_t> input_nm_;  // input vertex non-manifold: 1 / 0, −1 not computed yet
   bool features_on_ = false;
+  // UV islands (set 0) the collapse must neither cut in pieces nor, from
+  // params_.min_kept_island_area up, remove whole (issue 7); empty when off.
+  std::vector<Index> face_island_;  // per input face: its island, or kInvalidIndex
+  std::vector<Index> island_begin_, island_faces_;  // faces of island i: [begin[i], begin[i+1])
+  std::vector<std::uint8_t> island_keep_;   // 1: must keep a face (area >= min_kept_island_area)
+  std::vector<Index> island_pieces_;        // edge-connected pieces of the island in the input
+  std::vector<Index> island_token_;
+  Index island_tok_ = 0;
+  std::vector<Index> root_component_, root_component_token_;  // per root, during check_islands
+  Index component_tok_ = 0;
+  void protect_islands();
+  void check_islands(const std::vector<Index>& dirty);
+  template <class VertexOf>
+  Index island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component);
   FeatureEdges own_feat_;
   const FeatureEdges* feat_ptr_ = nullptr;
   FeatureReference own_reference_;
@@ -238,8 +252,100 @@ void Collapser::precompute() {
       own_reference_ = make_feature_reference(mesh_, conn_, *feat_ptr_);
       reference_ = &own_reference_;
     }
+    protect_islands();
   }
   build_vertex_terms();
+}
+
+// Islands the collapse keeps whole (docs/attributes.md, "Islands neither vanish nor split").
+// Seams are strict, so no cluster joins two islands, but nothing else stopped a cluster from
+// taking an island's last faces — a closed part without any feature line (an eyeball of
+// flightgear_head_amelia, 112 faces, one island) or a lone n-gon decal whose boundary is one
+// feature line (flightgear_cg57_cruiser_hd) collapsed whole — or from cutting it in two: a thin
+// tube (cg57, 4 quads around) whose two middle rings each collapse to a point leaves two cones
+// and drops the faces between, with no new boundary and no non-manifold vertex. Per-face layouts
+// are exempt: they must lose islands to be reduced at all.
+void Collapser::protect_islands() {
+  if (mesh_.uv_sets.empty() || params_.min_kept_island_area < 0.0) return;
+  const UvIslands islands = find_uv_islands(mesh_, conn_, 0);
+  std::vector<Index> size(islands.num_islands, 0);
+  Index with_uv = 0, alone = 0;
+  for (Index f = 0; f < nf_; ++f)
+    if (islands.face_island[f] != kInvalidIndex) ++size[islands.face_island[f]];
+  for (Index f = 0; f < nf_; ++f)
+    if (islands.face_island[f] != kInvalidIndex) {
+      ++with_uv;
+      alone += size[islands.face_island[f]] == 1;
+    }
+  if (double(alone) > params_.features.per_face_layout_fraction * double(with_uv)) return;
+  const Index n = islands.num_islands;
+  if (n == 0) return;
+  face_island_ = islands.face_island;
+  island_begin_.assign(n + 1, 0);
+  for (Index f = 0; f < nf_; ++f)
+    if (face_island_[f] != kInvalidIndex) ++island_begin_[face_island_[f] + 1];
+  for (Index i = 0; i < n; ++i) island_begin_[i + 1] += island_begin_[i];
+  island_faces_.resize(island_begin_[n]);
+  std::vector<Index> fill(island_begin_.begin(), island_begin_.end() - 1);
+  for (Index f = 0; f < nf_; ++f)
+    if (face_island_[f] != kInvalidIndex) island_faces_[fill[face_island_[f]]++] = f;
+  island_keep_.assign(n, 0);
+  island_pieces_.assign(n, 0);
+  for (Index i = 0; i < n; ++i) {
+    island_keep_[i] = islands.area_3d[i] > 0.0 && islands.area_3d[i] >= params_.min_kept_island_area;
+    island_pieces_[i] = island_components(i, [&](Index c) { return mesh_.corner_vertex[c]; }, nullptr);
+  }
+  island_token_.assign(n, 0);
+  root_component_.assign(nv_, kInvalidIndex);
+  root_component_token_.assign(nv_, 0);
+}
+
+// Edge-connected components of island i's faces with corners mapped by vertex_of (input
+// vertices, or output vertices = cluster roots over the surviving pieces). piece_component, when
+// given, gets each surviving piece's component, in the order of island_faces_ and pieces.
+template <class VertexOf>
+Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component) {
+  struct Side {
+    Index a, b, piece;
+    bool operator<(const Side& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : piece < o.piece; }
+  };
+  std::vector<Side> sides;
+  Index pieces = 0;
+  const bool built = piece_component != nullptr;
+  for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k) {
+    const Index f = island_faces_[k];
+    if (!built) {  // the input face itself
+      for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
+        const Index a = vertex_of(c), b = vertex_of(mesh_.face_begin(f) + (c + 1 - mesh_.face_begin(f)) % mesh_.face_size(f));
+        sides.push_back({std::min(a, b), std::max(a, b), pieces});
+      }
+      ++pieces;
+      continue;
+    }
+    Index off = piece_base(f);
+    for (Index p = 0; p < piece_count_[f]; ++p) {
+      const Index len = piece_buf_[off];
+      for (Index j = 0; j < len; ++j) {
+        const Index a = vertex_of(piece_buf_[off + 1 + j]), b = vertex_of(piece_buf_[off + 1 + (j + 1) % len]);
+        sides.push_back({std::min(a, b), std::max(a, b), pieces});
+      }
+      ++pieces;
+      off += len + 1;
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  UnionFind uf(pieces);
+  for (std::size_t k = 1; k < sides.size(); ++k)
+    if (sides[k].a == sides[k - 1].a && sides[k].b == sides[k - 1].b) uf.unite(sides[k].piece, sides[k - 1].piece);
+  Index components = 0;
+  std::vector<Index> id(pieces, kInvalidIndex);
+  if (built) piece_component->assign(pieces, kInvalidIndex);
+  for (Index p = 0; p < pieces; ++p) {
+    Index& c = id[uf.find(p)];
+    if (c == kInvalidIndex) c = components++;
+    if (built) (*piece_component)[p] = c;
+  }
+  return components;
 }
 
 // Per-vertex quadrics, after Knodt's simple_qem (see the file comment). Two deliberate changes:
@@ -1128,6 +1234,71 @@ void Collapser::check(const std::vector<Index>& dirty) {
       verts.push_back(r);
     }
   for (Index v : verts) check_vertex(v);
+  if (!face_island_.empty()) check_islands(dirty);
+}
+
+// Islands of dirty faces (refusal `island`):
+//   * vanished: an island of at least min_kept_island_area without any surviving face. The
+//     clusters at the corners of its largest face are refused (split, then dissolved), until that
+//     face survives; refusing every cluster on the island would undo far more than needed.
+//   * split: its surviving pieces fall into more edge-connected components than its input faces
+//     had (one). The clusters at the corners of the dropped faces between two components are
+//     refused — the ring of a tube collapsed to a point on each side of a dropped band.
+void Collapser::check_islands(const std::vector<Index>& dirty) {
+  ++island_tok_;
+  std::vector<Index> piece_component;
+  for (Index f : dirty) {
+    const Index i = face_island_[f];
+    if (i == kInvalidIndex || island_token_[i] == island_tok_) continue;
+    island_token_[i] = island_tok_;
+    const Index* begin = island_faces_.data() + island_begin_[i];
+    const Index* end = island_faces_.data() + island_begin_[i + 1];
+    if (!std::any_of(begin, end, [&](Index g) { return piece_count_[g] > 0; })) {
+      if (!island_keep_[i]) continue;
+      const Index* largest = std::max_element(begin, end, [&](Index a, Index b) { return face_area_[a] < face_area_[b]; });
+      for (Index c = mesh_.face_begin(*largest); c < mesh_.face_end(*largest); ++c)
+        blame(root_of_corner(c), CollapseRefusal::Island);
+      continue;
+    }
+    const Index components = island_components(i, [&](Index c) { return root_of_corner(c); }, &piece_component);
+    if (components <= island_pieces_[i]) continue;
+    // The component of every root on a surviving piece, then the dropped faces touching two.
+    ++component_tok_;
+    Index p = 0;
+    for (const Index* g = begin; g != end; ++g) {
+      Index off = piece_base(*g);
+      for (Index q = 0; q < piece_count_[*g]; ++q, ++p) {
+        const Index len = piece_buf_[off];
+        for (Index j = 0; j < len; ++j) {
+          const Index r = root_of_corner(piece_buf_[off + 1 + j]);
+          if (root_component_token_[r] != component_tok_) {
+            root_component_token_[r] = component_tok_;
+            root_component_[r] = piece_component[p];
+          }
+        }
+        off += len + 1;
+      }
+    }
+    bool blamed_any = false;
+    for (const Index* g = begin; g != end; ++g) {
+      if (piece_count_[*g] > 0) continue;
+      Index first = kInvalidIndex;
+      bool two = false;
+      for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) {
+        const Index r = root_of_corner(c);
+        if (root_component_token_[r] != component_tok_) continue;
+        if (first == kInvalidIndex) first = root_component_[r];
+        else two = two || root_component_[r] != first;
+      }
+      if (!two) continue;
+      blamed_any = true;
+      for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) blame(root_of_corner(c), CollapseRefusal::Island);
+    }
+    if (!blamed_any)  // no dropped face between two pieces: refuse every cluster on a dropped face
+      for (const Index* g = begin; g != end; ++g)
+        if (piece_count_[*g] == 0)
+          for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) blame(root_of_corner(c), CollapseRefusal::Island);
+  }
 }
 
 // --- driver ----------------------------------------------------------------------------------------
@@ -1514,6 +1685,7 @@ const char* to_string(CollapseRefusal reason) {
     case CollapseRefusal::Orientation: return "orientation";
     case CollapseRefusal::Hausdorff: return "hausdorff";
     case CollapseRefusal::Feature: return "feature";
+    case CollapseRefusal::Island: return "island";
   }
   return "unknown";
 }

@@ -158,6 +158,13 @@ struct ClusterCollapseParams {
   /// The features of the mesh being collapsed, when the caller has them already (borrowed; must
   /// match `features` and `conn`). nullptr: computed here.
   const FeatureEdges* feature_edges = nullptr;
+  /// With respect_features: a UV island (set 0) never falls apart into two pieces and, with at
+  /// least this 3D area, never loses its last face — the clusters that would do so are refused
+  /// (`island`). simplify() passes
+  /// the area of one output face (input area / target tri-equivalents), so only islands too small
+  /// for one output face may vanish (issue 7). < 0: islands are not checked at all. Per-face layouts
+  /// (FeatureParams::per_face_layout_fraction) are never protected.
+  double min_kept_island_area = 0.0;
 
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
@@ -181,8 +188,10 @@ enum class CollapseRefusal : std::uint8_t {
                       ///< an output edge leaves the strict line it continues (feature_tolerance),
                       ///< or an output edge with two faces covers an input boundary edge (a
                       ///< boundary zipped shut)
+  Island,             ///< a UV island would fall apart into two pieces, or, with at least
+                      ///< min_kept_island_area, lose its last face
 };
-inline constexpr std::size_t kNumCollapseRefusals = 10;
+inline constexpr std::size_t kNumCollapseRefusals = 11;
 const char* to_string(CollapseRefusal reason);
 
 enum class ClusterCollapseStatus : std::uint8_t {
