@@ -666,6 +666,10 @@ TEST(ClusterCollapseFeatures, IslandDoesNotVanishWhole) {
   ClusterCollapseParams small;
   small.min_kept_island_area = 7.0;
   EXPECT_EQ(collapse_clusters(in, conn, none_kept, small).mesh.num_faces(), 0u);
+  // ... unless it had more area in the original input of a multi-pass reduction.
+  const std::vector<double> original_area(in.num_faces(), 8.0);
+  small.face_island_area = &original_area;
+  EXPECT_GE(collapse_clusters(in, conn, none_kept, small).mesh.num_faces(), 1u);
 }
 
 // A thin tube (4 quads around, 3 along, one UV island without seams: one value per vertex) whose

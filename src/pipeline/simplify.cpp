@@ -478,6 +478,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   }
   PolyMesh current;
   const PolyMesh* pass_input = &input;
+  std::optional<UvIslands> input_islands;
+  if (options.features && !input.uv_sets.empty()) input_islands = find_uv_islands(input, build_connectivity(input), 0);
   // Output face → original input face, composed over the passes (exact island accounting).
   std::vector<Index> face_origin(input.num_faces());
   std::iota(face_origin.begin(), face_origin.end(), Index{0});
@@ -491,7 +493,18 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     const std::uint64_t pass_in = pass == 1 ? result.input_tri_equivalent : last.achieved;
     if (pass > 1 && pass_target >= pass_in) break;
     const std::string tag = planned == 1 && pass == 1 ? std::string() : " [pass " + std::to_string(pass) + "]";
+    // Islands are protected by their area in the original input (docs/attributes.md).
+    std::vector<double> face_island_area;
+    if (input_islands && cp.min_kept_island_area >= 0.0) {
+      face_island_area.resize(face_origin.size(), 0.0);
+      for (std::size_t f = 0; f < face_origin.size(); ++f) {
+        const Index i = input_islands->face_island[face_origin[f]];
+        if (i != kInvalidIndex) face_island_area[f] = input_islands->area_3d[i];
+      }
+      cp.face_island_area = &face_island_area;
+    }
     PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, dp, cp, log, tag);
+    cp.face_island_area = nullptr;
     if (!outcome.error.empty()) {
       result.error = outcome.error;
       return result;

@@ -292,7 +292,11 @@ void Collapser::protect_islands() {
   island_keep_.assign(n, 0);
   island_pieces_.assign(n, 0);
   for (Index i = 0; i < n; ++i) {
-    island_keep_[i] = islands.area_3d[i] > 0.0 && islands.area_3d[i] >= params_.min_kept_island_area;
+    double area = islands.area_3d[i];
+    if (params_.face_island_area && params_.face_island_area->size() == nf_)
+      for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k)
+        area = std::max(area, (*params_.face_island_area)[island_faces_[k]]);
+    island_keep_[i] = area > 0.0 && area >= params_.min_kept_island_area;
     island_pieces_[i] = island_components(i, [&](Index c) { return mesh_.corner_vertex[c]; }, nullptr);
   }
   island_token_.assign(n, 0);

@@ -165,6 +165,11 @@ struct ClusterCollapseParams {
   /// for one output face may vanish (issue 7). < 0: islands are not checked at all. Per-face layouts
   /// (FeatureParams::per_face_layout_fraction) are never protected.
   double min_kept_island_area = 0.0;
+  /// Per face of the mesh being collapsed: the 3D area of the island it comes from in the
+  /// original input (borrowed; nullptr: the island's own area here). A multi-pass reduction
+  /// shrinks islands (a curved part loses area as it is simplified), so an island worth two
+  /// output faces in the input could fall below the bound in a late pass and vanish there.
+  const std::vector<double>* face_island_area = nullptr;
 
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
