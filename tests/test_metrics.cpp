@@ -731,6 +731,71 @@ TEST(EvalFeatures, FaceAcrossASeamIsAMerge) {
   EXPECT_EQ(j["uv_islands_split"], 0);
 }
 
+/// Flat make_grid(2, 2) sheets at the heights z, stacked: one island each, all with the same UVs
+/// (nested eyeball shells, layered hair cards).
+PolyMesh stacked_sheets(const std::vector<double>& z) {
+  PolyMesh r;
+  r.uv_sets.assign(1, UvSet{});
+  for (double h : z) {
+    const PolyMesh g = make_grid(2, 2);
+    const Index v0 = r.num_vertices(), u0 = static_cast<Index>(r.uv_sets[0].values.size());
+    for (const Vec3& p : g.positions) r.positions.push_back(p + Vec3(0, 0, h));
+    for (const Vec2& uv : g.uv_sets[0].values) r.uv_sets[0].values.push_back(uv);
+    for (Index f = 0; f < g.num_faces(); ++f) {
+      std::vector<Index> vs;
+      for (Index v : g.face_vertices(f)) vs.push_back(v + v0);
+      const Index nf = r.add_face(vs);
+      for (Index i = 0; i < g.face_size(f); ++i) r.uv_sets[0].corner[r.face_begin(nf) + i] = g.uv_sets[0].corner[g.face_begin(f) + i] + u0;
+    }
+  }
+  return r;
+}
+
+// Twin islands: sheets A (z = 0) and B (z = 0.01) with the same UVs. An output with sheets at
+// z = 0.001 and 0.004 has both nearest A; the second one's votes also name B (within 2d, same
+// UV: a tie), and A comes first for both. A is not split: the second sheet takes B, which fits it
+// as well and is nobody's chart. An output with only the sheet at 0.004 keeps one island: B
+// vanished, although that sheet's votes name it.
+TEST(EvalFeatures, TwinIslandsAreNeitherSplitNorKeptByANameAlone) {
+  const PolyMesh in = stacked_sheets({0.0, 0.01});
+  expect_islands(evaluate(in, stacked_sheets({0.001, 0.004}), small_params()), 2, 2, 0, 0, 0);
+  expect_islands(evaluate(in, stacked_sheets({0.004}), small_params()), 2, 1, 1, 0, 0);
+}
+
+/// Appends a strip of quads over [xs[0], xs.back()] × [0, 1] (z = 0) with its own UV values
+/// (u = us[i] at x = xs[i], v = y): one island.
+void add_strip(PolyMesh& m, const std::vector<double>& xs, const std::vector<double>& us) {
+  if (m.uv_sets.empty()) m.uv_sets.assign(1, UvSet{});
+  const Index v0 = m.num_vertices(), u0 = static_cast<Index>(m.uv_sets[0].values.size());
+  for (std::size_t i = 0; i < xs.size(); ++i)
+    for (double y : {0.0, 1.0}) {
+      m.positions.push_back(Vec3(xs[i], y, 0.0));
+      m.uv_sets[0].values.push_back(Vec2(us[i], y));
+    }
+  for (Index i = 0; i + 1 < xs.size(); ++i) {
+    const std::vector<Index> f = {2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1};
+    const Index g = m.add_face({f[0] + v0, f[1] + v0, f[2] + v0, f[3] + v0});
+    for (Index k = 0; k < 4; ++k) m.uv_sets[0].corner[m.face_begin(g) + k] = f[k] + u0;
+  }
+}
+
+// A coarse face over a chart stretched unevenly: input island A = 4 columns over x in [0, 1] whose
+// u runs 0, 0.05, 0.1, 0.15, 1 (the last column stretched), and B, one quad over x in [1, 2] with
+// u = x − 1/3. The output keeps B and replaces A by one quad with A's corner UVs. At the centroid
+// (2/3, 1/3) of its first fan triangle the interpolated u is 2/3, A's is 0.13: off by more than a
+// quarter of A's diagonal, and B (u = 2/3 at its closest point) wins the vote. By centroids alone
+// the quad's island fits only B, which then has two pieces (a false split) and A none. Its
+// corners lie on A with A's UVs: the quad fits A, nothing is merged, split or vanished.
+TEST(EvalFeatures, CoarseFaceFitsItsChartAtTheCorners) {
+  PolyMesh in;
+  add_strip(in, {0, 0.25, 0.5, 0.75, 1}, {0, 0.05, 0.1, 0.15, 1});
+  add_strip(in, {1, 2}, {2.0 / 3, 5.0 / 3});
+  PolyMesh out;
+  add_strip(out, {0, 1}, {0, 1});
+  add_strip(out, {1, 2}, {2.0 / 3, 5.0 / 3});
+  expect_islands(evaluate(in, out, small_params()), 2, 2, 0, 0, 0);
+}
+
 TEST(EvalFeatures, MaterialsAreComparedByName) {
   const Index n = 4;
   PolyMesh in = make_grid(n, n);
