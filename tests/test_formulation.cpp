@@ -541,3 +541,34 @@ TEST(Formulation, ParallelAnnealingChainsGiveTheBestSerialChain) {
   }
   EXPECT_GE(cases, 2);
 }
+
+TEST(Formulation, ShortAnnealingSchedulesAlsoRunThePlainSchedule) {
+  // A schedule that ends by its move count (here 50 moves per free group, long before the time
+  // limit) also runs on Eq. 9 throughout from the same start; each schedule stops at the first
+  // multiple of 1 024 moves past its count, so the moves add up exactly.
+  const Prepared torus = prepare(mixed_torus());
+  const auto target = static_cast<std::uint64_t>(std::llround(0.6 * double(tri_equivalent_count(torus.mesh))));
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_moves_per_group = 50;
+  sp.solve.time_limit_seconds = 1;  // the annealing needs milliseconds; the rest goes to the MIPs
+  sp.strategy = SelectionParams::Strategy::Neighbourhoods;
+  sp.solve.threads = 1;
+  auto run = [&](const SelectionParams& p) { return select_edges(torus.mesh, torus.conn, torus.analysis, target, p); };
+  SelectionParams continuation_only = sp;
+  continuation_only.anneal_plain_when_short = false;
+  SelectionParams plain_only = continuation_only;
+  plain_only.anneal_count_weight = 1.0;
+  plain_only.anneal_band_relax = 0.0;
+  const SelectionResult both = run(sp), a = run(continuation_only), b = run(plain_only);
+  ASSERT_GT(a.anneal_moves, 0);
+  EXPECT_TRUE(a.anneal_converged);
+  EXPECT_EQ(both.anneal_moves, a.anneal_moves + b.anneal_moves);
+  // A plain schedule has nothing to add.
+  SelectionParams plain_with = plain_only;
+  plain_with.anneal_plain_when_short = true;
+  EXPECT_EQ(run(plain_with).anneal_moves, b.anneal_moves);
+  // Whichever won, the selection is feasible and no worse than the greedy start.
+  EXPECT_TRUE(both.band_enforced);
+  EXPECT_LE(both.flip_search_objective, both.greedy_objective + 1e-9);
+}

@@ -162,6 +162,11 @@ struct SelectionParams {
   double anneal_band_penalty = 4.0;
   double anneal_ramp_start = 0.6;
   double anneal_ramp_end = 0.95;
+  /// Where the annealing's schedule ends by its move count (small meshes) within half its time,
+  /// also run it on Eq. 9 throughout (count weight 1, no band relaxation) from the same start and
+  /// keep the lower Eq. 9: on short schedules the continuation can end above the plain annealing
+  /// (docs/formulation.md, "Speed").
+  bool anneal_plain_when_short = true;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
