@@ -262,6 +262,30 @@ TEST(SimplifyCorpus, SmallCorpusMeshesAreValidAndOnTarget) {
     }
   }
 }
+
+// flightgear_cg57_cruiser_hd at 0.6 with the greedy selection (deterministic): a 24-quad UV
+// island used to leave the collapse in two pieces that meet on one output side carrying five
+// faces — three of its own, two of a coincident twin sheet — which find_uv_islands does not join
+// across. The collapse now counts such sides as cuts and refuses the clusters at their ends
+// (docs/attributes.md, "Islands"). Exact accounting from provenance: nothing split or merged.
+TEST(SimplifyCorpus, IslandsAreNotCutAtSidesWithMoreThanTwoFaces) {
+  const std::filesystem::path file = std::filesystem::path(QUADLOD_CORPUS_DIR) / "flightgear_cg57_cruiser_hd.obj";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";
+  const ReadResult in = read_mesh(file);
+  ASSERT_TRUE(in.ok()) << in.error;
+  SimplifyOptions o;
+  o.ratio = 0.6;
+  o.time_limit_seconds = 0.0;
+  const SimplifyResult r = simplify(in.mesh, o);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const auto& islands = r.report["uv_islands"];
+  EXPECT_EQ(islands["in"], 12347);
+  EXPECT_EQ(islands["split"], 0) << islands["split_islands"];
+  EXPECT_EQ(islands["merged"], 0);
+  EXPECT_EQ(islands["appeared"], 0);
+  EXPECT_EQ(islands["vanished"], islands["vanished_below_one_face"]);
+  EXPECT_EQ(islands["out"], std::int64_t(islands["in"]) - std::int64_t(islands["vanished"]));
+}
 #endif
 
 }  // namespace

@@ -143,11 +143,19 @@ class Collapser {
   std::vector<Index> island_token_;
   Index island_tok_ = 0;
   std::vector<Index> root_component_, root_component_token_;  // per root, during check_islands
+  // Output sides that two or more pieces of the island being checked lie on, but that do not
+  // join them because more than two output faces lie there (find_uv_islands joins faces only
+  // across edges with exactly two): {a, b, piece} per piece on such a side.
+  struct IslandSide {
+    Index a, b, piece;
+  };
+  std::vector<IslandSide> unjoined_sides_;
   Index component_tok_ = 0;
   void protect_islands();
   void check_islands(const std::vector<Index>& dirty);
   template <class VertexOf>
   Index island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component);
+  Index pieces_on_side(Index a, Index b);
   FeatureEdges own_feat_;
   const FeatureEdges* feat_ptr_ = nullptr;
   FeatureReference own_reference_;
@@ -339,8 +347,26 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
   }
   std::sort(sides.begin(), sides.end());
   UnionFind uf(pieces);
-  for (std::size_t k = 1; k < sides.size(); ++k)
-    if (sides[k].a == sides[k - 1].a && sides[k].b == sides[k - 1].b) uf.unite(sides[k].piece, sides[k - 1].piece);
+  if (!built) {
+    for (std::size_t k = 1; k < sides.size(); ++k)
+      if (sides[k].a == sides[k - 1].a && sides[k].b == sides[k - 1].b) uf.unite(sides[k].piece, sides[k - 1].piece);
+  } else {
+    // find_uv_islands joins faces only across edges with exactly two faces, so an output side
+    // joins two pieces only if no other output face lies on it. A collapse can fold an island
+    // onto itself or onto a coincident sheet (flightgear_cg57_cruiser_hd at 0.6: one side with
+    // three faces of a 24-quad island and two of a twin sheet), and the island is then cut in
+    // two there although its UVs agree across the side. Such sides are kept for the blame.
+    unjoined_sides_.clear();
+    for (std::size_t k = 0; k < sides.size();) {
+      std::size_t end = k + 1;
+      while (end < sides.size() && sides[end].a == sides[k].a && sides[end].b == sides[k].b) ++end;
+      if (end - k == 2 && pieces_on_side(sides[k].a, sides[k].b) == 2)
+        uf.unite(sides[k].piece, sides[k + 1].piece);
+      else if (end - k >= 2)
+        for (std::size_t j = k; j < end; ++j) unjoined_sides_.push_back({sides[j].a, sides[j].b, sides[j].piece});
+      k = end;
+    }
+  }
   Index components = 0;
   std::vector<Index> id(pieces, kInvalidIndex);
   if (built) piece_component->assign(pieces, kInvalidIndex);
@@ -350,6 +376,30 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
     if (built) (*piece_component)[p] = c;
   }
   return components;
+}
+
+// Output pieces of every input face, the island's or not, with a side between roots a and b.
+// Uses the fan scratch tokens: called from check_islands, after every fan of the round is done.
+Index Collapser::pieces_on_side(Index a, Index b) {
+  Index count = 0;
+  ++fan_token_;
+  for (Index m : members(a))
+    for (Index c : conn_.corners_at_vertex(m)) {
+      const Index f = conn_.corner_face[c];
+      if (face_fan_token_[f] == fan_token_) continue;
+      face_fan_token_[f] = fan_token_;
+      Index off = piece_base(f);
+      for (Index p = 0; p < piece_count_[f]; ++p) {
+        const Index len = piece_buf_[off];
+        for (Index j = 0; j < len; ++j) {
+          const Index x = root_of_corner(piece_buf_[off + 1 + j]);
+          const Index y = root_of_corner(piece_buf_[off + 1 + (j + 1) % len]);
+          count += (x == a && y == b) || (x == b && y == a);
+        }
+        off += len + 1;
+      }
+    }
+  return count;
 }
 
 // Per-vertex quadrics, after Knodt's simple_qem (see the file comment). Two deliberate changes:
@@ -1284,6 +1334,25 @@ void Collapser::check_islands(const std::vector<Index>& dirty) {
       }
     }
     bool blamed_any = false;
+    // A side with more than two faces that would join two components if it had only the
+    // island's two: refuse the clusters at its ends, which made it (the island's own pieces
+    // folded onto one side, or a coincident sheet collapsed onto it).
+    for (std::size_t k = 0; k < unjoined_sides_.size();) {
+      std::size_t side_end = k + 1;
+      bool two = false;
+      while (side_end < unjoined_sides_.size() && unjoined_sides_[side_end].a == unjoined_sides_[k].a &&
+             unjoined_sides_[side_end].b == unjoined_sides_[k].b) {
+        two = two || piece_component[unjoined_sides_[side_end].piece] != piece_component[unjoined_sides_[k].piece];
+        ++side_end;
+      }
+      const Index a = unjoined_sides_[k].a, b = unjoined_sides_[k].b;
+      if (two && (cluster_size(a) > 1 || cluster_size(b) > 1)) {
+        blame(a, CollapseRefusal::Island);
+        blame(b, CollapseRefusal::Island);
+        blamed_any = true;
+      }
+      k = side_end;
+    }
     for (const Index* g = begin; g != end; ++g) {
       if (piece_count_[*g] > 0) continue;
       Index first = kInvalidIndex;
@@ -1327,7 +1396,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
   round_ = 0;
   for (Index v = 0; v < nv_; ++v)
     if (root_[v] == v && cluster_size(v) > 1) place(v);
-  std::vector<Index> dirty;
+  std::vector<Index> dirty, all_faces;
   for (Index f = 0; f < nf_; ++f) {
     rebuild_face(f);
     stats_.tri_equivalent_in += tri_equivalent(mesh_.face_size(f));
@@ -1343,6 +1412,16 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
     ++stats_.rounds;
     blamed_.clear();
     check(dirty);
+    if (blamed_.empty() && !face_island_.empty()) {
+      // A round can split an island none of whose faces it touched: collapsing a coincident
+      // sheet onto an island's edge makes that edge non-manifold (cg57 at 0.6). So before the
+      // collapse is final, every island is checked once more.
+      if (all_faces.empty()) {
+        all_faces.resize(nf_);
+        std::iota(all_faces.begin(), all_faces.end(), Index{0});
+      }
+      check_islands(all_faces);
+    }
     if (blamed_.empty()) break;
     // Refuse: split every blamed cluster (they are distinct clusters of this round).
     const bool dissolve = round_ >= params_.max_bisect_rounds;
