@@ -552,6 +552,19 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
     else if (k == 4) ++result.quads;
     else ++result.ngons;
   }
+  // The refusal kinds of the last pass that cost the most, "flip 12, folded_corner 8": which
+  // guarantee held the count up (report: collapse.refused_tri_equivalents).
+  auto costliest_refusals = [&]() -> std::string {
+    if (!last.report.contains("collapse") || !last.report["collapse"].contains("refused_tri_equivalents")) return {};
+    std::vector<std::pair<std::int64_t, std::string>> kinds;
+    for (const auto& [kind, cost] : last.report["collapse"]["refused_tri_equivalents"].items())
+      if (cost.get<std::int64_t>() > 0) kinds.emplace_back(cost.get<std::int64_t>(), kind);
+    std::sort(kinds.begin(), kinds.end(), [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+    std::string text;
+    for (std::size_t k = 0; k < kinds.size() && k < 3; ++k)
+      text += (k ? ", " : "") + kinds[k].second + " " + std::to_string(kinds[k].first);
+    return text.empty() ? text : "; triangle-equivalents kept by refusal kind: " + text;
+  };
   const double deviation = result.target ? (double(result.achieved) - double(result.target)) / double(result.target) : 0.0;
   if (result.note.empty() && std::abs(deviation) > options.epsilon_n && result.target < result.input_tri_equivalent) {
     // Say which limit bit in the last pass: the hard constraints of the selection (feature pins,
@@ -575,7 +588,7 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
                     static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
                     static_cast<unsigned long long>(result.target), result.passes_used,
                     static_cast<unsigned>(last.refusals));
-    result.note = text;
+    result.note = std::string(text) + costliest_refusals();
   }
   // UV islands, exactly, from provenance (docs/attributes.md, "Island accounting").
   if (!input.uv_sets.empty() && !result.mesh.uv_sets.empty() && face_origin.size() == result.mesh.num_faces()) {

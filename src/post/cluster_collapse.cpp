@@ -124,6 +124,7 @@ class Collapser {
   double diag_ = 1.0;       // input bbox diagonal
   double h_ = 1.0;          // mean input edge length
   double zero_area_ = 0.0;  // absolute area threshold
+  double zero_length_sq_ = 0.0;  // squared absolute side-length threshold
   double cos_flip_ = 0.0;
   double sin_fold_ = 0.0;  // a corner is reflex when it turns past 180° + corner_fold_tolerance
   double hausdorff_tol_ = 0.0;
@@ -227,6 +228,7 @@ void Collapser::precompute() {
   h_ = counted > 0 ? sum / counted : diag_;
 
   zero_area_ = std::max(0.0, params_.zero_area_epsilon) * diag_ * diag_;
+  zero_length_sq_ = std::pow(std::max(0.0, params_.zero_length_epsilon) * diag_, 2);
   const double flip = std::clamp(params_.flip_angle_deg, 1e-6, 180.0);
   cos_flip_ = std::cos(flip * std::numbers::pi / 180.0);
   sin_fold_ = std::sin(std::clamp(params_.corner_fold_tolerance_deg, 0.0, 90.0) * std::numbers::pi / 180.0);
@@ -931,6 +933,20 @@ void Collapser::check_face(Index f) {
     const Index* cs = piece_buf_.data() + off + 1;
     off += len + 1;
     auto at = [&](Index i) -> const Vec3& { return pos_[root_of_corner(cs[i])]; };
+    // A side shrunk to a point: two clusters placed on one spot. Only its two clusters are
+    // refused, and only if the input corners were apart (an input's own zero-length sides stay).
+    bool shrunk = false;
+    for (Index i = 0; i < len; ++i) {
+      const Index j = i + 1 == len ? 0 : i + 1;
+      if ((at(i) - at(j)).squaredNorm() > zero_length_sq_) continue;
+      const Vec3& a_in = mesh_.positions[conn_.corner_vertex[cs[i]]];
+      const Vec3& b_in = mesh_.positions[conn_.corner_vertex[cs[j]]];
+      if ((a_in - b_in).squaredNorm() <= zero_length_sq_) continue;
+      blame(root_of_corner(cs[i]), CollapseRefusal::DegenerateFace);
+      blame(root_of_corner(cs[j]), CollapseRefusal::DegenerateFace);
+      shrunk = true;
+    }
+    if (shrunk) continue;
     const Vec3 av = area_vector(len, at);
     const double area = av.norm();
     if (input_flat) {

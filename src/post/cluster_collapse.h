@@ -134,6 +134,12 @@ struct ClusterCollapseParams {
   /// An output face whose area is at most this times the squared bbox diagonal is degenerate
   /// (100× the threshold of MeshStats, so outputs pass compute_stats()).
   double zero_area_epsilon = 1e-12;
+  /// An output side at most this times the bbox diagonal long is degenerate, when its two input
+  /// corners were farther apart: two clusters placed on one point (a cluster clamped to the end
+  /// of its feature segment, where the next vertex sits). Default: the side of a square of
+  /// zero_area_epsilon. makehuman_teeth_base at 0.2 had up to 4 such edges per output, and one
+  /// on a seam counted as torn (eval cannot place a zero-length edge on the input seam).
+  double zero_length_epsilon = 1e-6;
   /// Bound on the one-sided distance, relative to the input bbox diagonal, from a placed cluster
   /// vertex and from the midpoints of its new edges to unmoved neighbours, to the input faces
   /// around the cluster. <= 0: no bound.
@@ -184,7 +190,7 @@ enum class CollapseRefusal : std::uint8_t {
   NonManifoldVertex,  ///< an output vertex whose fan splits, no member was non-manifold
   NewBoundary,        ///< an output edge with 1 face whose input edges all had >= 2
   DuplicateFace,      ///< two output faces on the same vertex set (not input duplicates)
-  DegenerateFace,     ///< an output face with zero area
+  DegenerateFace,     ///< an output face with zero area, or a side the collapse shrank to zero length
   Flip,               ///< an output face turned more than flip_angle_deg from its input face
   FoldedCorner,       ///< a convex polygon corner became reflex
   Orientation,        ///< an output face faces away from the nearest input surface (§6b rule)
