@@ -289,9 +289,9 @@ TEST(SimplifyCorpus, IslandsAreNotCutAtSidesWithMoreThanTwoFaces) {
 }
 
 // makehuman_teeth_base has no edge shorter than 10⁻⁶ of its diagonal; at 0.2 with the greedy
-// selection (deterministic) the collapse used to place two clusters on one point three times (a
-// cluster clamped to the end of its feature segment, where the next vertex sits): zero-length
-// edges, one of them on a seam that eval counted as torn. Refused as `degenerate_face` now.
+// selection (deterministic) the collapse used to place two clusters on one point three times:
+// zero-length edges (in other runs one lay on a seam, and eval counted it as torn). Refused as
+// `degenerate_face` now.
 TEST(SimplifyCorpus, NoEdgeIsShrunkToAPoint) {
   const std::filesystem::path file = std::filesystem::path(QUADLOD_CORPUS_DIR) / "makehuman_teeth_base.obj";
   if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";

@@ -135,10 +135,10 @@ struct ClusterCollapseParams {
   /// (100× the threshold of MeshStats, so outputs pass compute_stats()).
   double zero_area_epsilon = 1e-12;
   /// An output side at most this times the bbox diagonal long is degenerate, when its two input
-  /// corners were farther apart: two clusters placed on one point (a cluster clamped to the end
-  /// of its feature segment, where the next vertex sits). Default: the side of a square of
-  /// zero_area_epsilon. makehuman_teeth_base at 0.2 had up to 4 such edges per output, and one
-  /// on a seam counted as torn (eval cannot place a zero-length edge on the input seam).
+  /// corners were farther apart: two clusters placed on one point (or a cluster on an unmoved
+  /// neighbour). Default: the side of a square of zero_area_epsilon. makehuman_teeth_base at 0.2
+  /// had up to 4 such edges per output, on and off feature lines, and one on a seam counted as
+  /// torn (eval cannot place a zero-length edge on the input seam).
   double zero_length_epsilon = 1e-6;
   /// Bound on the one-sided distance, relative to the input bbox diagonal, from a placed cluster
   /// vertex and from the midpoints of its new edges to unmoved neighbours, to the input faces
