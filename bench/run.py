@@ -64,6 +64,7 @@ COLUMNS = [
     "qpr", "qpr_rule", "pccd", "pccd_defined", "chamfer", "hausdorff",
     "nonmanifold_edges_new", "nonmanifold_edges", "nonmanifold_vertices",
     "degenerate_faces", "degenerate_faces_in", "duplicate_faces", "duplicate_faces_in",
+    "zero_length_edges", "zero_length_edges_in",
     "flipped_faces", "flipped_faces_kept", "boundary_edges", "boundary_edges_in", "components", "components_in",
     "flow_deviation_deg", "flow_deviation_p90_deg", "flow_coverage",
     "seconds_read", "seconds_analysis", "seconds_select", "seconds_dual", "seconds_collapse",
@@ -648,6 +649,8 @@ class Bench:
                    nonmanifold_vertices=val.get("nonmanifold_vertices"),
                    degenerate_faces=val.get("degenerate_faces"),
                    duplicate_faces=val.get("duplicate_faces"),
+                   zero_length_edges=val.get("zero_length_edges"),
+                   zero_length_edges_in=val.get("zero_length_edges_in"),
                    flipped_faces=ev.get("flipped_faces", val.get("flipped_faces")),
                    flipped_faces_kept=ev.get("flipped_faces_kept"),
                    boundary_edges=val.get("boundary_edges"), components=val.get("components"),
@@ -968,7 +971,7 @@ def validity_section(rows):
         probs = []
         if (num(r.get("nonmanifold_edges_new")) or 0) > 0:
             probs.append("%d new non-manifold edges" % num(r["nonmanifold_edges_new"]))
-        for k in ("degenerate_faces", "duplicate_faces"):
+        for k in ("degenerate_faces", "duplicate_faces", "zero_length_edges"):
             if (num(r.get(k)) or 0) > (num(r.get(k + "_in")) or 0):
                 probs.append("%s %d (input %d)" % (k.replace("_", " "), num(r[k]), num(r.get(k + "_in")) or 0))
         if (num(r.get("flipped_faces")) or 0) > 0:
@@ -977,7 +980,7 @@ def validity_section(rows):
             bad.append((r, probs))
     out = ["## Validity: outputs worse than their input\n"]
     out.append("Outputs with new non-manifold edges, or more degenerate or duplicate faces than the "
-               "input, or faces flipped against the input surface (`flipped_faces`, docs/metrics.md §6b).\n")
+               "input, more zero-length edges (two vertices on one point), or faces flipped against the input surface (`flipped_faces`, docs/metrics.md §6b).\n")
     if bad:
         out.append("| mesh | ratio | method | problems |")
         out.append("|---|---:|---|---|")

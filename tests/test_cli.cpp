@@ -42,7 +42,7 @@ TEST_F(CliTest, InfoJsonHasTheDocumentedKeys) {
   for (const char* key : {"vertices", "faces", "triangles", "quads", "ngons", "tri_equivalent",
                           "boundary_edges", "nonmanifold_edges", "degenerate_faces", "components",
                           "has_uvs", "bbox", "edges", "boundary_loops", "nonmanifold_vertices",
-                          "duplicate_faces", "faces_by_degree"})
+                          "duplicate_faces", "zero_length_edges", "faces_by_degree"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["faces"], 51);
   EXPECT_EQ(j["quads"], 40);

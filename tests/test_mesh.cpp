@@ -196,6 +196,10 @@ TEST(Validation, DegenerateAndDuplicateFaces) {
   const Index c = m.add_vertex(Vec3(7, 0, 0));
   m.add_face({a, b, c});     // collinear: zero area
   m.add_face({0, 1, 1, 4});  // repeated index
+  // Two distinct vertices on one point: a quad shaped like a triangle, with area.
+  const Index d = m.add_vertex(Vec3(10, 0, 0)), e = m.add_vertex(Vec3(10, 0, 0));
+  const Index f = m.add_vertex(Vec3(11, 1, 0)), g = m.add_vertex(Vec3(10, 1, 0));
+  m.add_face({d, e, f, g});
   const MeshStats s = stats_of(m);
   EXPECT_EQ(s.duplicate_faces, 2u);
   EXPECT_EQ(s.zero_area_faces, 1u);  // the collinear triangle; the repeated-index quad has area
@@ -204,6 +208,8 @@ TEST(Validation, DegenerateAndDuplicateFaces) {
   // Face 0's four edges now carry three or more faces each; (1,1) and (0,4) of the repeated-index
   // quad are boundary edges.
   EXPECT_EQ(s.nonmanifold_edges, 4u);
+  // Zero length: (d, e), and (1, 1) of the repeated-index quad.
+  EXPECT_EQ(s.zero_length_edges, 2u);
 }
 
 TEST(Validation, PipelineInputChecks) {

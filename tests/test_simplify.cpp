@@ -27,6 +27,7 @@ void expect_valid(const PolyMesh& in, const PolyMesh& out, const std::string& wh
   EXPECT_LE(b.nonmanifold_edges, a.nonmanifold_edges) << what;
   EXPECT_LE(b.degenerate_faces, a.degenerate_faces) << what;
   EXPECT_LE(b.duplicate_faces, a.duplicate_faces) << what;
+  EXPECT_LE(b.zero_length_edges, a.zero_length_edges) << what;
   EXPECT_EQ(b.nonfinite_vertices, 0u) << what;
   EXPECT_EQ(b.unused_vertices, 0u) << what;
   // No face facing away from the input surface (docs/metrics.md §6b; the collapse's

@@ -72,6 +72,8 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
                   {"nonmanifold_vertices", validity.nonmanifold_vertices},
                   {"degenerate_faces", validity.degenerate_faces},
                   {"duplicate_faces", validity.duplicate_faces},
+                  {"zero_length_edges", validity.zero_length_edges},
+                  {"zero_length_edges_in", input_validity.zero_length_edges},
                   {"boundary_edges", validity.boundary_edges},
                   {"components", validity.components},
                   {"new_nonmanifold_edges",

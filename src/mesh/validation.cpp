@@ -77,7 +77,10 @@ MeshStats compute_stats(const PolyMesh& mesh, const Connectivity& conn,
     else bucket.push_back(f);
   }
 
+  const double zero_length = params.zero_length_epsilon * diag;
   for (Index e = 0; e < conn.num_edges; ++e) {
+    const auto [a, b] = conn.edge_vertices[e];
+    s.zero_length_edges += !((mesh.positions[a] - mesh.positions[b]).norm() > zero_length);
     s.boundary_edges += conn.is_boundary_edge(e);
     s.nonmanifold_edges += conn.is_nonmanifold_edge(e);
   }
@@ -121,6 +124,7 @@ nlohmann::json to_json(const MeshStats& s) {
       {"repeated_index_faces", s.repeated_index_faces},
       {"zero_area_faces", s.zero_area_faces},
       {"duplicate_faces", s.duplicate_faces},
+      {"zero_length_edges", s.zero_length_edges},
       {"components", s.components},
       {"nonfinite_vertices", s.nonfinite_vertices},
       {"has_uvs", s.has_uvs},

@@ -34,6 +34,7 @@ struct MeshStats {
   Index repeated_index_faces = 0;  ///< faces that use one vertex twice
   Index zero_area_faces = 0;       ///< area <= zero_area_epsilon · bbox_diagonal²
   Index duplicate_faces = 0;       ///< faces whose vertex set equals an earlier face's
+  Index zero_length_edges = 0;     ///< edges between two vertices <= zero_length_epsilon · bbox_diagonal apart
   Index components = 0;            ///< face components through shared edges
   Index nonfinite_vertices = 0;    ///< vertices with a NaN or infinite coordinate
   bool has_uvs = false;            ///< every corner has a UV in the first UV set
@@ -49,6 +50,10 @@ struct MeshStatsParams {
   /// A face is "zero area" when its area is at most this times the squared bbox diagonal.
   /// 1e-14 is ~100 ulps of a unit-scale area in double: exact collinear corners only.
   double zero_area_epsilon = 1e-14;
+  /// An edge is "zero length" when its vertices are at most this times the bbox diagonal apart:
+  /// the side of a square of zero_area_epsilon. Two distinct vertices on one point make a
+  /// degenerate polygon side that no face-area test sees.
+  double zero_length_epsilon = 1e-7;
 };
 
 MeshStats compute_stats(const PolyMesh& mesh, const Connectivity& conn,
