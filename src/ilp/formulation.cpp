@@ -1566,6 +1566,281 @@ std::vector<std::uint8_t> anneal_chains(const Groups& g, const GroupConstraints&
   return std::move(results[best]);
 }
 
+// ------------------------------------------------------------------------------------------
+// Recombination of independent parts (beyond the paper; docs/formulation.md, "Speed"). The free
+// groups fall into components that share no term of Eq. 9 and no constraint: two free groups are
+// in one component if they share a face (t_f), an Eq. 6 cluster, an Eq. 7 cluster or an Eq. 8
+// pair of clusters (split pairs share a face). Only the count row |N' − N| (Eqs. 1–2) couples the
+// components, so Eq. 9 = |Σ_c N'_c + N'_fixed − N| + Σ_c cost_c(y_c). A price μ per
+// triangle-equivalent in place of the count term makes the problem separable (a Lagrangian
+// relaxation of Eq. 1): a descent on cost + μ N' from the incumbent improves every component on
+// its own. Each price's end state offers every component an alternative (ΔN'_c, Δcost_c); a
+// multiple-choice knapsack over the count offset (a dynamic programme over N' − N within Eq. 2's
+// band) then picks one alternative per component (or its incumbent) minimising Eq. 9 exactly.
+// A component collapsing a chord at a loss of less than a triangle-equivalent per removed one
+// can so be paired with a component keeping a chord elsewhere for more than that — a pair the
+// count term's price of 1 in both directions hides from every single move and from regions that
+// do not hold both parts. c172p (an aircraft of many separate parts) has 968 components, the
+// largest of 554 of its 22 131 free groups.
+struct FreeComponents {
+  Index count = 0;
+  std::vector<Index> of_group;         // kInvalidIndex for fixed groups
+  std::vector<Index> offsets, groups;  // CSR component → groups
+};
+
+FreeComponents free_components(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg) {
+  UnionFind uf(g.count);
+  auto join = [&](auto begin, auto end) {
+    Index first = kInvalidIndex;
+    for (auto it = begin; it != end; ++it) {
+      if (g.fixed[*it]) continue;
+      if (first == kInvalidIndex) first = *it;
+      else uf.unite(first, *it);
+    }
+  };
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f) join(fg.group.begin() + fg.offsets[f], fg.group.begin() + fg.offsets[f + 1]);
+  for (const auto& c : gc.geo) join(c.begin(), c.end());
+  for (const auto& c : gc.tri) join(c.begin(), c.end());
+  std::vector<Index> both;
+  for (const auto& [i, j] : gc.tri_neighbours) {
+    both = gc.tri[i];
+    both.insert(both.end(), gc.tri[j].begin(), gc.tri[j].end());
+    join(both.begin(), both.end());
+  }
+  for (const auto& [a, b] : gc.split_pairs) {
+    const Index pair[2] = {a, b};
+    join(pair, pair + 2);
+  }
+  FreeComponents fc;
+  fc.of_group.assign(g.count, kInvalidIndex);
+  std::vector<Index> of_root(g.count, kInvalidIndex);
+  for (Index x = 0; x < g.count; ++x) {
+    if (g.fixed[x]) continue;
+    const Index r = uf.find(x);
+    if (of_root[r] == kInvalidIndex) of_root[r] = fc.count++;
+    fc.of_group[x] = of_root[r];
+  }
+  fc.offsets.assign(std::size_t{fc.count} + 1, 0);
+  for (Index x = 0; x < g.count; ++x)
+    if (fc.of_group[x] != kInvalidIndex) ++fc.offsets[fc.of_group[x] + 1];
+  std::partial_sum(fc.offsets.begin(), fc.offsets.end(), fc.offsets.begin());
+  fc.groups.resize(fc.offsets.back());
+  std::vector<Index> fill(fc.offsets.begin(), fc.offsets.end() - 1);
+  for (Index x = 0; x < g.count; ++x)
+    if (fc.of_group[x] != kInvalidIndex) fc.groups[fill[fc.of_group[x]]++] = x;
+  return fc;
+}
+
+// Per component: its N'_c (faces with a free group in it) and cost_c (Eq. 9 without the count
+// term: λ_edge, λ_geo and λ_tri terms of its groups, clusters and split pairs).
+void component_totals(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg, const FreeComponents& fc,
+                      const std::vector<std::uint8_t>& y, const SelectionParams& params,
+                      std::vector<std::int64_t>& count, std::vector<double>& cost) {
+  count.assign(fc.count, 0);
+  cost.assign(fc.count, 0.0);
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f)
+    for (Index i = fg.offsets[f]; i < fg.offsets[f + 1]; ++i)
+      if (const Index c = fc.of_group[fg.group[i]]; c != kInvalidIndex) {
+        count[c] += face_count(fg, f, y);
+        break;
+      }
+  for (Index x = 0; x < g.count; ++x)
+    if (fc.of_group[x] != kInvalidIndex) cost[fc.of_group[x]] -= params.lambda_edge * y[x] * g.importance[x];
+  for (const auto& cl : gc.geo)
+    if (std::none_of(cl.begin(), cl.end(), [&](Index x) { return y[x]; })) cost[fc.of_group[cl[0]]] += params.lambda_geo;
+  for (const auto& [a, b] : gc.split_pairs)
+    if (y[a] != y[b]) cost[fc.of_group[g.fixed[a] ? b : a]] += params.lambda_tri;
+}
+
+// Descent on cost + μ N' (no count term, no band: the recombination enforces Eq. 2): single
+// flips, swaps with an adjacent group of the other value, and chains along split partners (as
+// chain_moves), while they lower it; Eq. 8 is kept.
+void priced_descent(SelectionState& st, const Groups& g, const GroupConstraints& gc, double mu,
+                    const SelectionParams& params, const std::vector<Index>& adj_offsets,
+                    const std::vector<Index>& adjacent, const Stopwatch& clock, double seconds) {
+  constexpr double eps = 1e-9;
+  constexpr std::size_t max_chain = 64;
+  std::vector<Index> stamp(g.count, kInvalidIndex), queue;
+  std::vector<std::pair<Index, std::int64_t>> flipped;
+  int passes = 0;
+  for (bool improved = true; improved && clock.seconds() < seconds && passes < params.recombination_passes;) {
+    improved = false;
+    ++passes;
+    for (Index a = 0; a < g.count; ++a) {
+      if (g.fixed[a]) continue;
+      const std::int64_t dc = st.delta_count(a);
+      if (st.delta_rest(a, params) + mu * double(dc) < -eps && (!st.y[a] || st.may_collapse(a))) {
+        st.flip(a, dc);
+        improved = true;
+      }
+    }
+    for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
+      if (g.fixed[b] || st.y[b]) continue;
+      const std::int64_t db = st.delta_count(b);
+      const double rb = st.delta_rest(b, params) + mu * double(db);
+      st.flip(b, db);
+      Index best_a = kInvalidIndex;
+      std::int64_t best_da = 0;
+      double best_gain = -eps;
+      for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
+        const Index a = adjacent[k];
+        if (g.fixed[a] || !st.y[a] || !st.may_collapse(a)) continue;
+        const std::int64_t da = st.delta_count(a);
+        const double gain = rb + st.delta_rest(a, params) + mu * double(da);
+        if (gain < best_gain) best_gain = gain, best_a = a, best_da = da;
+      }
+      if (best_a != kInvalidIndex) {
+        st.flip(best_a, best_da);
+        improved = true;
+      } else {
+        st.flip(b, -db);
+      }
+    }
+    for (Index seed = 0; seed < g.count && clock.seconds() < seconds; ++seed) {
+      if (g.fixed[seed]) continue;
+      const std::uint8_t v = st.y[seed];
+      if (std::none_of(gc.group_split[seed].begin(), gc.group_split[seed].end(),
+                       [&](Index b) { return !g.fixed[b] && st.y[b] == v; }))
+        continue;
+      double change = 0.0, best_gain = -eps;
+      std::size_t best_len = 0;
+      flipped.clear();
+      queue.assign(1, seed);
+      stamp[seed] = seed;
+      for (std::size_t head = 0; head < queue.size() && flipped.size() < max_chain; ++head) {
+        const Index a = queue[head];
+        if (st.y[a] != v || (v && !st.may_collapse(a))) continue;
+        const std::int64_t dc = st.delta_count(a);
+        change += st.delta_rest(a, params) + mu * double(dc);
+        st.flip(a, dc);
+        flipped.emplace_back(a, dc);
+        if (change < best_gain) best_gain = change, best_len = flipped.size();
+        for (Index b : gc.group_split[a])
+          if (!g.fixed[b] && stamp[b] != seed && st.y[b] == v) {
+            stamp[b] = seed;
+            queue.push_back(b);
+          }
+      }
+      while (flipped.size() > best_len) {
+        st.flip(flipped.back().first, -flipped.back().second);
+        flipped.pop_back();
+      }
+      improved |= best_len > 0;
+    }
+  }
+}
+
+struct RecombineStats {
+  Index rounds = 0, improved = 0, components = 0, moved = 0;
+};
+
+// Rounds of: one priced descent per price from the incumbent, then the dynamic programme over
+// the components' alternatives; a round that does not lower Eq. 9 ends the search. y must lie in
+// Eq. 2's band; the result does too.
+std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                               std::vector<std::uint8_t> y, std::uint64_t target,
+                                               const SelectionParams& params, double seconds,
+                                               const std::vector<Index>& adj_offsets,
+                                               const std::vector<Index>& adjacent, RecombineStats& stats) {
+  Stopwatch clock;
+  const FreeComponents fc = free_components(g, gc, fg);
+  stats.components = fc.count;
+  const std::vector<double>& prices = params.recombination_prices;
+  if (fc.count == 0 || prices.empty()) return y;
+  const auto n = static_cast<std::int64_t>(target);
+  const auto band = static_cast<std::int64_t>(std::floor(params.epsilon_n * double(target)));
+  std::vector<std::int64_t> count0, count1;
+  std::vector<double> cost0, cost1;
+  std::vector<std::vector<std::uint8_t>> states(prices.size());
+  struct Option {
+    std::int64_t dc;
+    double dcost;
+    std::uint8_t state;
+  };
+  std::vector<std::vector<Option>> options(fc.count);
+  std::vector<double> dp, next;
+  std::vector<std::uint8_t> choice;
+  std::vector<Index> with_options;
+  while (clock.seconds() < seconds && stats.rounds < params.recombination_rounds) {
+    ++stats.rounds;
+    component_totals(g, gc, fg, fc, y, params, count0, cost0);
+    std::int64_t total = 0;
+    {
+      SelectionState st(g, gc, fg, y);
+      total = st.count;
+    }
+    for (auto& o : options) o.clear();
+    // The count term's slope at the incumbent: 0 between its two sides at N' = N (prices go up
+    // from there: keeping a group always gains λ_edge Q), ±1 near the band's edges, where one
+    // direction is closed (cg57 sits on the upper edge); the prices are offsets from it.
+    const double slope = 2 * std::abs(total - n) > band ? (total > n ? 1.0 : -1.0) : 0.0;
+    for (std::size_t k = 0; k < prices.size() && clock.seconds() < seconds; ++k) {
+      const double price = slope + (slope < 0.0 ? -prices[k] : prices[k]);
+      SelectionState st(g, gc, fg, y);
+      priced_descent(st, g, gc, price, params, adj_offsets, adjacent, clock, seconds);
+      states[k] = std::move(st.y);
+      component_totals(g, gc, fg, fc, states[k], params, count1, cost1);
+      for (Index c = 0; c < fc.count; ++c) {
+        const std::int64_t dc = count1[c] - count0[c];
+        const double dcost = cost1[c] - cost0[c];
+        if (dc == 0 && dcost >= -1e-9) continue;  // no better than the incumbent
+        auto& opts = options[c];
+        auto same = std::find_if(opts.begin(), opts.end(), [&](const Option& o) { return o.dc == dc; });
+        if (same == opts.end()) opts.push_back({dc, dcost, static_cast<std::uint8_t>(k)});
+        else if (dcost < same->dcost) *same = {dc, dcost, static_cast<std::uint8_t>(k)};
+      }
+    }
+    // The programme (also when the time cut the descents short: every state they reached is a
+    // valid alternative, and the programme takes milliseconds): dp[s] = least Σ Δcost over the components so far with N' − N = s + lo; the
+    // range covers Eq. 2's band and the incumbent's count (which may lie outside it: then any
+    // combination in the band is taken).
+    const std::int64_t d0 = total - n, lo = std::min(-band, d0), hi = std::max(band, d0);
+    const std::size_t width = std::size_t(hi - lo + 1);
+    dp.assign(width, INFINITY);
+    with_options.clear();
+    for (Index c = 0; c < fc.count; ++c)
+      if (!options[c].empty()) with_options.push_back(c);
+    if (with_options.empty()) break;
+    dp[std::size_t(d0 - lo)] = 0.0;
+    choice.assign(with_options.size() * width, 0);
+    for (std::size_t i = 0; i < with_options.size(); ++i) {
+      const auto& opts = options[with_options[i]];
+      next = dp;  // choice 0: the incumbent
+      std::uint8_t* ch = &choice[i * width];
+      for (std::size_t s = 0; s < width; ++s) {
+        if (!(dp[s] < INFINITY)) continue;
+        for (std::size_t k = 0; k < opts.size(); ++k) {
+          const std::int64_t t = std::int64_t(s) + opts[k].dc;
+          if (t < 0 || t >= std::int64_t(width)) continue;
+          const double v = dp[s] + opts[k].dcost;
+          if (v < next[std::size_t(t)] - 1e-12) next[std::size_t(t)] = v, ch[t] = static_cast<std::uint8_t>(k + 1);
+        }
+      }
+      dp.swap(next);
+    }
+    const double before = std::abs(d0) <= band ? double(std::abs(d0)) : INFINITY;
+    std::size_t best_s = std::size_t(d0 - lo);
+    double best = before;  // every incumbent kept
+    for (std::int64_t d = -band; d <= band; ++d) {
+      const std::size_t s = std::size_t(d - lo);
+      if (dp[s] < INFINITY && dp[s] + double(std::llabs(d)) < best - 1e-9) best = dp[s] + double(std::llabs(d)), best_s = s;
+    }
+    if (!(best < before - 1e-9) || !(best < INFINITY)) break;
+    // Back-track: component i's choice at state s; the previous state is s − its Δcount.
+    for (std::size_t i = with_options.size(); i-- > 0;) {
+      const std::uint8_t k = choice[i * width + best_s];
+      if (k == 0) continue;
+      const Index c = with_options[i];
+      const Option& o = options[c][k - 1];
+      for (Index j = fc.offsets[c]; j < fc.offsets[c + 1]; ++j) y[fc.groups[j]] = states[o.state][fc.groups[j]];
+      best_s = std::size_t(std::int64_t(best_s) - o.dc);
+      ++stats.moved;
+    }
+    ++stats.improved;
+  }
+  return y;
+}
+
 // Groups that share a face, as CSR.
 void group_adjacency(const Groups& g, const FaceGroups& fg, std::vector<Index>& offsets,
                      std::vector<Index>& adjacent) {
@@ -1821,13 +2096,17 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       result.anneal_converged = as.schedule_done;
       result.seconds_anneal = anneal_clock.seconds();
     }
+    // The recombination (after annealing only) takes its share from the end of the descent's.
+    const double recombination_fraction =
+        params.formulation == Formulation::Fast && result.anneal_moves > 0 ? params.recombination_fraction : 0.0;
     Stopwatch flip_clock;
     FlipSearchStats fs;
     // After annealing the descent only gets what is left up to descent_end_fraction of the
     // budget (the neighbourhood MIPs get the rest).
     const double flip_budget =
         result.anneal_moves > 0
-            ? std::min(params.flip_search_time_fraction * time_limit, std::max(0.0, params.descent_end_fraction * time_limit - clock.seconds()))
+            ? std::min(params.flip_search_time_fraction * time_limit,
+                       std::max(0.0, (params.descent_end_fraction - recombination_fraction) * time_limit - clock.seconds()))
             : params.flip_search_time_fraction * time_limit;
     start_y = flip_search(groups, gc, fg, std::move(start_y), target, params, flip_budget, adj_offsets, adjacent, fs);
     result.flip_passes = fs.passes;
@@ -1838,6 +2117,35 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     result.compounds = fs.compounds;
     result.flip_search_converged = fs.converged;
     result.seconds_flip_search = flip_clock.seconds();
+    // Recombination of independent parts after the descent (fast formulation, after
+    // annealing), then a second descent if it changed anything.
+    if (recombination_fraction > 0.0) {
+      Stopwatch recombine_clock;
+      RecombineStats rs;
+      const double before = group_objective(groups, gc, fg, start_y, target, params);
+      const std::vector<std::uint8_t> unrecombined = start_y;
+      start_y = recombine_components(groups, gc, fg, std::move(start_y), target, params,
+                                     params.descent_end_fraction * time_limit - clock.seconds(), adj_offsets,
+                                     adjacent, rs);
+      result.recombination_rounds = rs.rounds;
+      result.recombination_improved = rs.improved;
+      result.recombination_moved = rs.moved;
+      result.components = rs.components;
+      result.seconds_recombination = recombine_clock.seconds();
+      result.recombination_gain = before - group_objective(groups, gc, fg, start_y, target, params);
+      if (result.recombination_gain < -1e-6 * std::max(1.0, std::abs(before))) {  // never: the programme is exact
+        assert(false);
+        start_y = unrecombined;
+        result.recombination_gain = 0.0;
+        rs.improved = 0;
+      }
+      if (rs.improved > 0) {
+        FlipSearchStats fs2;
+        start_y = flip_search(groups, gc, fg, std::move(start_y), target, params,
+                              std::max(0.0, params.descent_end_fraction * time_limit - clock.seconds()), adj_offsets,
+                              adjacent, fs2);
+      }
+    }
   }
 
   const std::vector<double> banded_start = banded.complete(start_y, target);
@@ -1986,6 +2294,21 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
   FlipSearchStats stats;
   const std::vector<std::uint8_t> y =
       flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);
+  std::vector<std::uint8_t> kept(conn.num_edges);
+  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
+  return kept;
+}
+
+std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                    std::uint64_t target, const SelectionParams& params,
+                                    const std::vector<std::uint8_t>& edge_kept, Index* components) {
+  Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  std::vector<Index> adj_offsets, adjacent;
+  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  RecombineStats stats;
+  const std::vector<std::uint8_t> y = recombine_components(p.groups, p.gc, p.fg, std::move(p.y), target, params,
+                                                           INFINITY, adj_offsets, adjacent, stats);
+  if (components) *components = stats.components;
   std::vector<std::uint8_t> kept(conn.num_edges);
   for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
   return kept;

@@ -143,6 +143,21 @@ struct SelectionParams {
   double anneal_time_fraction = 0.9;
   /// After annealing, the descent runs until this fraction of the time limit has passed.
   double descent_end_fraction = 0.97;
+  /// Recombination of independent parts (docs/formulation.md, "Speed"; fast formulation, after
+  /// annealing): the free groups fall into components coupled only by the count row; priced
+  /// descents (Eq. 9 with the count term replaced by μ N', one per price) offer each component
+  /// alternatives, and a dynamic programme over N' − N picks the combination with the lowest
+  /// Eq. 9 in Eq. 2's band; then the descent runs again. It takes recombination_fraction of the
+  /// time limit from the end of the first descent's share (0 = off), for up to
+  /// recombination_rounds rounds (a round that gains nothing ends it), each priced descent up to
+  /// recombination_passes passes. The prices are offsets from the count term's slope at the
+  /// incumbent (0 at N' = N, ±1 near the band's edges). Measured at 0.4, 5 s: the round gains
+  /// 50–80 on c172p (0.1–0.2 s) and 270–380 on cg57 (0.25 s; prices 0.25–0.75 without the slope
+  /// found nothing there, and 4 passes per price did not fit in 0.35 s).
+  double recombination_fraction = 0.07;
+  Index recombination_rounds = 1;
+  int recombination_passes = 2;
+  std::vector<double> recombination_prices = {0.0, 0.25, 0.5, 0.75, 1.0};
   double anneal_t0 = 8.0;
   double anneal_t1 = 0.05;
   /// The annealing also ends after this many moves per free group (small meshes).
@@ -222,6 +237,10 @@ struct SelectionResult {
   double seconds_flip_search = 0.0;
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
   double seconds_anneal = 0.0;
+  Index components = 0;                 ///< independent parts (components of the free groups)
+  Index recombination_rounds = 0, recombination_improved = 0, recombination_moved = 0;
+  double seconds_recombination = 0.0;
+  double recombination_gain = 0.0;      ///< Eq. 9 lowered by the recombination (before the second descent)
   SelectionModelStats model;
   /// Why the selection stopped (docs/formulation.md, "Speed"): "nothing to do", "greedy" (no
   /// time limit, or a target out of reach on a model too large for a whole MIP), "optimal" (whole-model MIP proven optimal), "converged" (the neighbourhood
@@ -278,6 +297,14 @@ ilp::Model neighbourhood_model(const PolyMesh& mesh, const Connectivity& conn, c
 std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                        std::uint64_t target, const SelectionParams& params,
                                        const std::vector<std::uint8_t>& edge_kept, double seconds);
+
+/// The recombination of independent parts of select_edges() alone (no annealing, no descent),
+/// from the selection `edge_kept` (uniform per group, N' in Eq. 2's band), for
+/// params.recombination_rounds rounds or until a round gains nothing; returns the edge bits it
+/// ends at. `components`, if given, receives the number of independent parts.
+std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                    std::uint64_t target, const SelectionParams& params,
+                                    const std::vector<std::uint8_t>& edge_kept, Index* components = nullptr);
 
 }  // namespace detail
 
