@@ -118,7 +118,8 @@ TEST(Formulation, EdgeImportanceIsZeroOnAFlatMeshAndPositiveOnACube) {
 
 TEST(Formulation, NothingToDoAboveInputSize) {
   const Prepared p = prepare(make_grid(3, 3));
-  const SelectionResult r = select_edges(p.mesh, p.conn, p.analysis, 18);
+  const SelectionParams defaults;  // a named object: g++ 12 warns falsely on the temporary's std::function
+  const SelectionResult r = select_edges(p.mesh, p.conn, p.analysis, 18, defaults);
   EXPECT_NE(r.note.find("nothing to do"), std::string::npos);
   EXPECT_EQ(std::count(r.edge_kept.begin(), r.edge_kept.end(), 1), long(p.conn.num_edges));
   EXPECT_FALSE(r.solver_ran);
@@ -192,7 +193,8 @@ TEST(Formulation, UnreachableTargetIsReportedWithTheClosestSelection) {
   AnalysisParams ap;
   ap.segmentation.enable = false;
   const Prepared p = prepare(make_cube(1), ap);
-  const SelectionResult r = select_edges(p.mesh, p.conn, p.analysis, 3);
+  const SelectionParams defaults;  // see NothingToDoAboveInputSize
+  const SelectionResult r = select_edges(p.mesh, p.conn, p.analysis, 3, defaults);
   EXPECT_FALSE(r.band_enforced);
   EXPECT_NE(r.note.find("out of reach"), std::string::npos);
   EXPECT_TRUE(eq4_holds(p, r.edge_kept));
