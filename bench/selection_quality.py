@@ -1,7 +1,7 @@
 """Selection quality vs time budget (issue 4). Run through bench/selection_quality.
 
 For every mesh × ratio × formulation × time limit it runs
-    quadlod -q simplify MESH -o OUT --ratio R --time-limit S --max-rounds 1 --max-passes 1
+    quadlod -q simplify MESH -o OUT --ratio R --time-limit S --max-rounds 1 --max-passes 1 --no-greedy-fallback
             --formulation F
             --threads 1 --report REPORT [extra args]
 one at a time (the machine is shared: timings are wall clock), and reads report.selection.
@@ -67,7 +67,7 @@ def main():
                         load = open("/proc/loadavg").read().split()[0]
                         cmd = [a.quadlod, "-q", "simplify", src, "-o", os.path.join(a.out, name + ".obj"),
                                "--ratio", ratio, "--time-limit", limit, "--max-rounds", "1",
-                               "--max-passes", "1", "--formulation", form, "--threads", "1", "--report", report] + a.extra
+                               "--max-passes", "1", "--no-greedy-fallback", "--formulation", form, "--threads", "1", "--report", report] + a.extra
                         print("running:", " ".join(cmd), file=sys.stderr, flush=True)
                         t = time.time()
                         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)

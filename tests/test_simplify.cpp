@@ -210,6 +210,7 @@ TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {
   EXPECT_NE(ok.out.find("simplify: target"), std::string::npos) << ok.out;
   const auto report = nlohmann::json::parse(slurp(dir / "r.json"));
   EXPECT_TRUE(report.contains("stage_seconds"));
+  EXPECT_TRUE(report["options"]["greedy_fallback"].get<bool>());
   const ReadResult out = read_mesh(dir / "out.obj");
   ASSERT_TRUE(out.ok()) << out.error;
   EXPECT_EQ(report["achieved"].get<std::uint64_t>(), tri_equivalent_count(out.mesh));
@@ -219,6 +220,14 @@ TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {
   EXPECT_EQ(same.exit_code, 2);
   EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
   EXPECT_EQ(slurp(in), before);
+  // The fallback can be switched off (bench/selection_quality measures the selection alone).
+  const CliRun off = run_cli("-q simplify '" + in.string() + "' -o '" + (dir / "off.obj").string() +
+                                 "' --ratio 0.5 --time-limit 1 --no-greedy-fallback --report '" + (dir / "off.json").string() + "'",
+                             dir);
+  EXPECT_EQ(off.exit_code, 0) << off.err;
+  const auto off_report = nlohmann::json::parse(slurp(dir / "off.json"));
+  EXPECT_FALSE(off_report["options"]["greedy_fallback"].get<bool>());
+  EXPECT_FALSE(off_report.contains("fallback"));
   // No target is a usage error.
   EXPECT_EQ(run_cli("-q simplify '" + in.string() + "' -o '" + (dir / "x.obj").string() + "'", dir).exit_code, 1);
   std::filesystem::remove_all(dir);
@@ -287,6 +296,57 @@ TEST(SimplifyCorpus, IslandsAreNotCutAtSidesWithMoreThanTwoFaces) {
   EXPECT_EQ(islands["appeared"], 0);
   EXPECT_EQ(islands["vanished"], islands["vanished_below_one_face"]);
   EXPECT_EQ(islands["out"], std::int64_t(islands["in"]) - std::int64_t(islands["vanished"]));
+}
+
+// blender_suzanne at 0.2: the optimised selections meet more `flip` / `folded_corner` refusals
+// than the rounds can re-aim for (+9 % to +24 % in the corpus runs of session 6), the greedy
+// selection's run (deterministic) ends at 195 of 194. With the fallback the output is within
+// Eq. 2's band whichever run the optimised one was; without it, nothing else is tried.
+TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
+  const std::filesystem::path file = std::filesystem::path(QUADLOD_CORPUS_DIR) / "blender_suzanne.obj";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";
+  const ReadResult in = read_mesh(file);
+  ASSERT_TRUE(in.ok()) << in.error;
+  SimplifyOptions greedy = quick(0.2);
+  greedy.time_limit_seconds = 0.0;
+  const SimplifyResult g = simplify(in.mesh, greedy);
+  ASSERT_TRUE(g.ok()) << g.error;
+  ASSERT_EQ(g.target, 194u);
+  EXPECT_EQ(g.achieved, 195u);
+  EXPECT_FALSE(g.report.contains("fallback"));  // a greedy run has nothing to fall back to
+
+  const SimplifyResult r = simplify(in.mesh, quick(0.2));
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_LE(std::abs(double(r.achieved) - 194.0), 0.03 * 194.0);
+  expect_valid(in.mesh, r.mesh, "suzanne 0.2");
+  if (r.report.contains("fallback")) {
+    const auto& f = r.report["fallback"];
+    EXPECT_EQ(f["greedy_achieved"], 195);
+    EXPECT_EQ(f["kept"], "greedy");
+    EXPECT_EQ(r.achieved, 195u);
+    EXPECT_GT(std::abs(f["optimised_achieved"].get<double>() - 194.0), 0.03 * 194.0);
+    EXPECT_EQ(r.report["options"]["time_limit_seconds"], 1.0);  // what was asked for
+  }
+  // One pass of one round misses by far either way (the collapse refuses most of what a single
+  // selection at 0.2 asks for), so the fallback always runs: the greedy run ends at 540, and
+  // the output is whichever of the two is closer to 194.
+  SimplifyOptions single = quick(0.2);
+  single.max_passes = 1;
+  single.max_rounds = 1;
+  const SimplifyResult s = simplify(in.mesh, single);
+  ASSERT_TRUE(s.ok()) << s.error;
+  ASSERT_TRUE(s.report.contains("fallback"));
+  const auto& f = s.report["fallback"];
+  EXPECT_EQ(f["greedy_achieved"], 540);
+  const auto optimised = f["optimised_achieved"].get<std::int64_t>();
+  EXPECT_EQ(std::int64_t(s.achieved), std::abs(optimised - 194) < std::abs(540 - 194) ? optimised : 540);
+  EXPECT_EQ(f["kept"], std::int64_t(s.achieved) == optimised ? "optimised" : "greedy");
+  EXPECT_NE(s.note.find("the greedy selection's 540"), std::string::npos) << s.note;
+  expect_valid(in.mesh, s.mesh, "suzanne 0.2, one pass");
+
+  SimplifyOptions off = single;
+  off.greedy_fallback = false;
+  EXPECT_FALSE(simplify(in.mesh, off).report.contains("fallback"));
 }
 
 // makehuman_teeth_base has no edge shorter than 10⁻⁶ of its diagonal; at 0.2 with the greedy

@@ -20,7 +20,7 @@ struct SimplifyCliOptions {
   std::string formulation = "fast";
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
-  bool no_features = false;
+  bool no_features = false, no_greedy_fallback = false;
 };
 
 }  // namespace
@@ -76,6 +76,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.05, 0.95))->capture_default_str()->group("Guarantees");
   sub->add_option("--max-passes", p.max_passes, "Most passes (1 = one global selection, as in the paper)")
       ->check(CLI::Range(1, 32))->capture_default_str()->group("Guarantees");
+  sub->add_flag("--no-greedy-fallback", opt->no_greedy_fallback,
+                "Keep the optimised selection's output even when a greedy selection's run gets closer to the target")
+      ->group("Guarantees");
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
@@ -112,6 +115,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.segmentation = !opt->no_segmentation;
             p.geometry = !opt->no_geometry;
             p.dual_repair = !opt->no_dual;
+            p.greedy_fallback = !opt->no_greedy_fallback;
             p.features = !opt->no_features;
             p.progress = !global.quiet;
             SimplifyResult r = simplify(in.mesh, p);

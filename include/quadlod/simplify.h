@@ -65,6 +65,10 @@ struct SimplifyOptions {
   /// Most passes, the planned ones and extra ones that aim at N after a miss. 1 = one pass, the
   /// paper's single global selection.
   int max_passes = 6;
+  /// When the output misses Eq. 2's band, run the pipeline again with the greedy selection and
+  /// keep the output closer to the target (report: `fallback`). Beyond the paper; off in
+  /// measurements of the selection itself (bench/selection_quality).
+  bool greedy_fallback = true;
 
   // --- ablations (paper Table 2) ----------------------------------------------------------------
   bool consistency = true;   ///< Eq. 4

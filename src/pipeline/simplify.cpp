@@ -20,10 +20,24 @@
 
 namespace quadlod {
 
-double default_lambda_geo() { return SelectionParams{}.lambda_geo; }
-double default_stall_seconds() { return SelectionParams{}.whole_stall_seconds; }
-double default_lambda_edge() { return SelectionParams{}.lambda_edge; }
-double default_lambda_tri() { return SelectionParams{}.lambda_tri; }
+// Named objects, not temporaries: g++ 12 warns falsely (maybe-uninitialized) on the destructor
+// of a temporary SelectionParams's std::function.
+double default_lambda_geo() {
+  const SelectionParams defaults;
+  return defaults.lambda_geo;
+}
+double default_stall_seconds() {
+  const SelectionParams defaults;
+  return defaults.whole_stall_seconds;
+}
+double default_lambda_edge() {
+  const SelectionParams defaults;
+  return defaults.lambda_edge;
+}
+double default_lambda_tri() {
+  const SelectionParams defaults;
+  return defaults.lambda_tri;
+}
 
 namespace {
 
@@ -394,7 +408,8 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
 
 }  // namespace
 
-SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+// One run of the whole pipeline: passes of rounds of selection, repair and collapse.
+static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions& options) {
   SimplifyResult result;
   Stopwatch total;
   if (std::string problem = check_pipeline_input(input); !problem.empty()) {
@@ -654,11 +669,59 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
       {"later_round_time_fraction", options.later_round_time_fraction},
       {"pass_ratio", options.pass_ratio},
       {"max_passes", options.max_passes},
+      {"greedy_fallback", options.greedy_fallback},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +
                (result.passes_used > 1 ? " in " + std::to_string(result.passes_used) + " passes" : ""));
   return result;
+}
+
+// Beyond the paper: a run whose output misses Eq. 2's band is followed by one with the greedy
+// selection (deterministic, milliseconds per pass), and the output closer to the target is kept.
+// On small meshes at low ratios the optimised selections meet more collapse refusals (`flip`,
+// `folded_corner`) than the rounds can re-aim for: at 0.2, blender_suzanne ended at +24 % and
+// the greedy run at +0.5 %, amelia −3.5 % / −0.5 %, yofrankie_ram +19 % / +8.5 %, the crane
+// +26 % / +15 %, with QPR, Chamfer and Hausdorff of the same order (docs/formulation.md,
+// "Rounds against refused collapses").
+SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+  Stopwatch total;
+  SimplifyResult optimised = simplify_once(input, options);
+  auto miss = [](const SimplifyResult& r) {
+    return r.target ? std::abs(double(r.achieved) - double(r.target)) / double(r.target) : 0.0;
+  };
+  if (!optimised.ok() || !options.greedy_fallback || !(options.time_limit_seconds > 0.0) ||
+      optimised.target >= optimised.input_tri_equivalent || miss(optimised) <= options.epsilon_n)
+    return optimised;
+  if (options.progress)
+    std::fprintf(stderr, "simplify: achieved %llu is %+.1f %% off the target; trying the greedy selection\n",
+                 static_cast<unsigned long long>(optimised.achieved),
+                 100.0 * (double(optimised.achieved) - double(optimised.target)) / double(optimised.target));
+  SimplifyOptions greedy_options = options;
+  greedy_options.time_limit_seconds = 0.0;
+  Stopwatch greedy_clock;
+  SimplifyResult greedy = simplify_once(input, greedy_options);
+  const double greedy_seconds = greedy_clock.seconds();
+  const bool keep_greedy = greedy.ok() && miss(greedy) < miss(optimised);
+  char text[256];
+  std::snprintf(text, sizeof text, "the optimised selection's run achieved %llu (%+.1f %%), the greedy selection's %llu (%+.1f %%)",
+                static_cast<unsigned long long>(optimised.achieved),
+                100.0 * (double(optimised.achieved) - double(optimised.target)) / double(optimised.target),
+                static_cast<unsigned long long>(greedy.achieved),
+                100.0 * (double(greedy.achieved) - double(greedy.target)) / double(greedy.target));
+  const nlohmann::json fallback = {{"optimised_achieved", optimised.achieved},
+                                   {"greedy_achieved", greedy.ok() ? nlohmann::json(greedy.achieved) : nlohmann::json()},
+                                   {"kept", keep_greedy ? "greedy" : "optimised"},
+                                   {"seconds_greedy", greedy_seconds}};
+  SimplifyResult& kept = keep_greedy ? greedy : optimised;
+  if (keep_greedy) kept.report["options"] = optimised.report["options"];  // what was asked for
+  kept.report["fallback"] = fallback;
+  kept.report["seconds"] = total.seconds();
+  if (!kept.note.empty()) kept.note += std::string("; ") + text + ", kept the " + (keep_greedy ? "greedy" : "optimised") + " one";
+  kept.report["note"] = kept.note;
+  if (options.progress)
+    std::fprintf(stderr, "simplify: %s; kept the %s one\n", text, keep_greedy ? "greedy" : "optimised");
+  return std::move(kept);
 }
 
 }  // namespace quadlod
