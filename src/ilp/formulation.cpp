@@ -1021,15 +1021,18 @@ struct FlipSearchStats {
 //     seg 1     seg 2     seg 3          collapsing seg 2 alone splits the quads at both
 //   ┌──┬──┐  ┌──┬──┐  ┌──┬──┐          breakpoints (2 λ_tri); seg 1–3 together split none
 //   └──┴──┘  └──┴──┘  └──┴──┘
-bool chain_moves(SelectionState& st, const Groups& g, const GroupConstraints& gc, std::uint64_t target,
-                 const SelectionParams& params, const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
+//
+// chain_walk is that walk under any count term: `count_term(N')` replaces |N' − N| and only
+// prefixes with `in_band(N')` count (the priced descent of the recombination passes μ N' and
+// no band). Returns the number of chains applied.
+template <class CountTerm, class InBand>
+Index chain_walk(SelectionState& st, const Groups& g, const GroupConstraints& gc, const SelectionParams& params,
+                 const Stopwatch& clock, double seconds, CountTerm&& count_term, InBand&& in_band) {
   constexpr std::size_t max_chain = 64;
-  const double n = double(target), band = params.epsilon_n * n, eps = 1e-9;
-  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
-  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  constexpr double eps = 1e-9;
   std::vector<Index> stamp(g.count, kInvalidIndex), queue;
   std::vector<std::pair<Index, std::int64_t>> flipped;  // group, Δcount when flipped
-  bool applied = false;
+  Index applied = 0;
   for (Index seed = 0; seed < g.count && clock.seconds() < seconds; ++seed) {
     if (g.fixed[seed]) continue;
     const std::uint8_t v = st.y[seed];
@@ -1066,12 +1069,19 @@ bool chain_moves(SelectionState& st, const Groups& g, const GroupConstraints& gc
       st.flip(flipped.back().first, -flipped.back().second);
       flipped.pop_back();
     }
-    if (best_len > 0) {
-      ++stats.chains;
-      applied = true;
-    }
+    applied += best_len > 0;
   }
   return applied;
+}
+
+bool chain_moves(SelectionState& st, const Groups& g, const GroupConstraints& gc, std::uint64_t target,
+                 const SelectionParams& params, const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
+  const double n = double(target), band = params.epsilon_n * n;
+  const Index applied = chain_walk(
+      st, g, gc, params, clock, seconds, [&](std::int64_t c) { return std::abs(double(c) - n); },
+      [&](std::int64_t c) { return std::abs(double(c) - n) <= band; });
+  stats.chains += applied;
+  return applied > 0;
 }
 
 // Pair exchanges: keep one collapsed group and collapse one kept group *anywhere* on the mesh,
@@ -1693,9 +1703,6 @@ void priced_descent(SelectionState& st, const Groups& g, const GroupConstraints&
                     const SelectionParams& params, const std::vector<Index>& adj_offsets,
                     const std::vector<Index>& adjacent, const Stopwatch& clock, double seconds) {
   constexpr double eps = 1e-9;
-  constexpr std::size_t max_chain = 64;
-  std::vector<Index> stamp(g.count, kInvalidIndex), queue;
-  std::vector<std::pair<Index, std::int64_t>> flipped;
   int passes = 0;
   for (bool improved = true; improved && clock.seconds() < seconds && passes < params.recombination_passes;) {
     improved = false;
@@ -1730,37 +1737,9 @@ void priced_descent(SelectionState& st, const Groups& g, const GroupConstraints&
         st.flip(b, -db);
       }
     }
-    for (Index seed = 0; seed < g.count && clock.seconds() < seconds; ++seed) {
-      if (g.fixed[seed]) continue;
-      const std::uint8_t v = st.y[seed];
-      if (std::none_of(gc.group_split[seed].begin(), gc.group_split[seed].end(),
-                       [&](Index b) { return !g.fixed[b] && st.y[b] == v; }))
-        continue;
-      double change = 0.0, best_gain = -eps;
-      std::size_t best_len = 0;
-      flipped.clear();
-      queue.assign(1, seed);
-      stamp[seed] = seed;
-      for (std::size_t head = 0; head < queue.size() && flipped.size() < max_chain; ++head) {
-        const Index a = queue[head];
-        if (st.y[a] != v || (v && !st.may_collapse(a))) continue;
-        const std::int64_t dc = st.delta_count(a);
-        change += st.delta_rest(a, params) + mu * double(dc);
-        st.flip(a, dc);
-        flipped.emplace_back(a, dc);
-        if (change < best_gain) best_gain = change, best_len = flipped.size();
-        for (Index b : gc.group_split[a])
-          if (!g.fixed[b] && stamp[b] != seed && st.y[b] == v) {
-            stamp[b] = seed;
-            queue.push_back(b);
-          }
-      }
-      while (flipped.size() > best_len) {
-        st.flip(flipped.back().first, -flipped.back().second);
-        flipped.pop_back();
-      }
-      improved |= best_len > 0;
-    }
+    improved |= chain_walk(
+                    st, g, gc, params, clock, seconds, [&](std::int64_t c) { return mu * double(c); },
+                    [](std::int64_t) { return true; }) > 0;
   }
 }
 

@@ -20,24 +20,16 @@
 
 namespace quadlod {
 
-// Named objects, not temporaries: g++ 12 warns falsely (maybe-uninitialized) on the destructor
-// of a temporary SelectionParams's std::function.
-double default_lambda_geo() {
-  const SelectionParams defaults;
-  return defaults.lambda_geo;
+// One named, immutable default object rather than temporaries: g++ 12 warns falsely
+// (maybe-uninitialized) on the destructor of a temporary SelectionParams's std::function.
+static const SelectionParams& selection_defaults() {
+  static const SelectionParams defaults;
+  return defaults;
 }
-double default_stall_seconds() {
-  const SelectionParams defaults;
-  return defaults.whole_stall_seconds;
-}
-double default_lambda_edge() {
-  const SelectionParams defaults;
-  return defaults.lambda_edge;
-}
-double default_lambda_tri() {
-  const SelectionParams defaults;
-  return defaults.lambda_tri;
-}
+double default_lambda_geo() { return selection_defaults().lambda_geo; }
+double default_stall_seconds() { return selection_defaults().whole_stall_seconds; }
+double default_lambda_edge() { return selection_defaults().lambda_edge; }
+double default_lambda_tri() { return selection_defaults().lambda_tri; }
 
 namespace {
 

@@ -380,27 +380,17 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
   return components;
 }
 
-// Output pieces of every input face, the island's or not, with a side between roots a and b.
-// Uses the fan scratch tokens: called from check_islands, after every fan of the round is done.
+// Output pieces of every input face, the island's or not, with a side between roots a and b:
+// the sides next to a in its fan. Rebuilds fan_: called from check_islands, after every fan of
+// the round is done.
 Index Collapser::pieces_on_side(Index a, Index b) {
+  gather_fan(a);
   Index count = 0;
-  ++fan_token_;
-  for (Index m : members(a))
-    for (Index c : conn_.corners_at_vertex(m)) {
-      const Index f = conn_.corner_face[c];
-      if (face_fan_token_[f] == fan_token_) continue;
-      face_fan_token_[f] = fan_token_;
-      Index off = piece_base(f);
-      for (Index p = 0; p < piece_count_[f]; ++p) {
-        const Index len = piece_buf_[off];
-        for (Index j = 0; j < len; ++j) {
-          const Index x = root_of_corner(piece_buf_[off + 1 + j]);
-          const Index y = root_of_corner(piece_buf_[off + 1 + (j + 1) % len]);
-          count += (x == a && y == b) || (x == b && y == a);
-        }
-        off += len + 1;
-      }
-    }
+  for (const auto& e : fan_) {
+    const Index* cs = piece_buf_.data() + e.first;
+    count += root_of_corner(cs[(e.pos + 1) % e.len]) == b;
+    count += root_of_corner(cs[(e.pos + e.len - 1) % e.len]) == b;
+  }
   return count;
 }
 
