@@ -342,6 +342,8 @@ TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
   EXPECT_EQ(std::int64_t(s.achieved), std::abs(optimised - 194) < std::abs(540 - 194) ? optimised : 540);
   EXPECT_EQ(f["kept"], std::int64_t(s.achieved) == optimised ? "optimised" : "greedy");
   EXPECT_NE(s.note.find("the greedy selection's 540"), std::string::npos) << s.note;
+  // The note names what held the count up: the costliest refusal kinds of the last pass.
+  EXPECT_NE(s.note.find("triangle-equivalents kept by refusal kind: "), std::string::npos) << s.note;
   expect_valid(in.mesh, s.mesh, "suzanne 0.2, one pass");
 
   SimplifyOptions off = single;
