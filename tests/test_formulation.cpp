@@ -516,24 +516,28 @@ TEST(Formulation, RelaxedAnnealingEndsInTheBandAndKeepsEveryConstraint) {
   }
 }
 
-TEST(Formulation, ParallelAnnealingChainsGiveTheBestSerialChain) {
-  // solve.threads = k runs k chains (seeds seed, seed + 1, …) and keeps the one with the lowest
-  // Eq. 9; with schedules ended by move count (deterministic) the result is one of the serial
-  // runs with those seeds, the same every time whichever thread finishes first.
+TEST(Formulation, AnnealingRunsOnThreadsGiveOneOfTheSerialRuns) {
+  // solve.threads = k threads of anneal_runs runs each: run i (thread i mod k, its (i div k)-th
+  // run) has seed seed + i, and the run with the lowest Eq. 9 is kept (ties: the lowest seed).
+  // With schedules ended by move count (deterministic) the result is that of one of the serial
+  // single runs with those seeds, the same every time whichever thread finishes first.
   const Prepared torus = prepare(mixed_torus());
   SelectionParams sp;
   sp.lambda_edge = 0.3;
   sp.anneal_time_fraction = 0.8;
   sp.anneal_moves_per_group = 200;
+  sp.anneal_runs = 2;
+  sp.anneal_max_runs = 2;
   int cases = 0;
   for (const SearchCase& c : search_cases({&torus}, sp)) {
     SelectionParams parallel = sp;
     parallel.solve.threads = 3;
     const auto b = detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, parallel, c.start, 600.0);
     bool found = false;
-    for (std::uint32_t k = 0; k < 3; ++k) {
+    for (std::uint32_t k = 0; k < 6; ++k) {
       SelectionParams serial = sp;
       serial.solve.threads = 1;
+      serial.anneal_runs = serial.anneal_max_runs = 1;
       serial.solve.seed = sp.solve.seed + k;
       found |= detail::local_search(c.p->mesh, c.p->conn, c.p->analysis, c.target, serial, c.start, 600.0) == b;
     }
@@ -556,6 +560,7 @@ TEST(Formulation, ShortAnnealingSchedulesAlsoRunThePlainSchedule) {
   sp.solve.time_limit_seconds = 1;  // the annealing needs milliseconds; the rest goes to the MIPs
   sp.strategy = SelectionParams::Strategy::Neighbourhoods;
   sp.solve.threads = 1;
+  sp.anneal_runs = sp.anneal_max_runs = 1;
   auto run = [&](const SelectionParams& p) { return select_edges(torus.mesh, torus.conn, torus.analysis, target, p); };
   SelectionParams continuation_only = sp;
   continuation_only.anneal_plain_when_short = false;
@@ -619,4 +624,65 @@ TEST(Formulation, RecombinationOfIndependentParts) {
   }
   EXPECT_GE(cases, 6);
   EXPECT_GE(better, 1) << "the recombination never improved the greedy selection";
+}
+
+TEST(Formulation, RecombinationTakesEachPartFromTheBestRun) {
+  // Three independent parts. An annealed selection X is split over two other selections: B is X
+  // with part 0 as in the incumbent (the count-only greedy selection), C is X with part 1 as in
+  // the incumbent. With no priced descents the recombination chooses, per part, the incumbent's,
+  // B's or C's: its Eq. 9 must be the least over all 3^3 combinations in Eq. 2's band (a
+  // brute-force oracle), which includes X itself, reassembled from B and C; so on the targets
+  // where X beats the greedy on both parts it lies below all three selections it was given.
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.recombination_prices.clear();
+  sp.recombination_rounds = 1;
+  sp.anneal_moves_per_group = 100;
+  sp.anneal_runs = sp.anneal_max_runs = 1;
+  const PolyMesh cylinder_torus =
+      two_parts(make_cylinder(10, 5), make_torus(7, 10, 0.9, 0.3), Vec3(3.0, 0.0, 0.0));
+  const Index base1 = cylinder_torus.num_vertices();
+  const Prepared p = prepare(two_parts(cylinder_torus, mixed_torus(), Vec3(0.0, 3.0, 0.0)));
+  const Index base0 = make_cylinder(10, 5).num_vertices();
+  auto part_of = [&](Index e) {
+    const Index v = p.conn.edge_vertices[e][0];
+    return v < base0 ? 0 : v < base1 ? 1 : 2;
+  };
+  int cases = 0, below_all = 0;
+  for (const SearchCase& c : search_cases({&p}, sp)) {
+    const auto x = detail::local_search(p.mesh, p.conn, p.analysis, c.target, sp, c.start, 600.0);
+    auto with_part_of_start = [&](int part) {
+      std::vector<std::uint8_t> kept = x;
+      for (Index e = 0; e < p.conn.num_edges; ++e)
+        if (part_of(e) == part) kept[e] = c.start[e];
+      return kept;
+    };
+    const std::vector<std::vector<std::uint8_t>> states{c.start, with_part_of_start(0), with_part_of_start(1)};
+    Index components = 0;
+    const auto kept = detail::recombine(p.mesh, p.conn, p.analysis, c.target, sp, c.start, &components,
+                                        {states[1], states[2]});
+    ASSERT_EQ(components, 3u);
+    const double band = sp.epsilon_n * double(c.target);
+    auto in_band = [&](const std::vector<std::uint8_t>& k) {
+      return std::abs(double(predicted_tri_equivalent(p.mesh, p.conn, k)) - double(c.target)) <= band + 1e-9;
+    };
+    double oracle = INFINITY, best_given = INFINITY;
+    for (const auto& st : states)
+      if (in_band(st)) best_given = std::min(best_given, eq9(p, st, c.target, sp));
+    std::vector<std::uint8_t> combined(p.conn.num_edges);
+    for (int choice = 0; choice < 27; ++choice) {
+      const int pick[3] = {choice % 3, choice / 3 % 3, choice / 9};
+      for (Index e = 0; e < p.conn.num_edges; ++e) combined[e] = states[pick[part_of(e)]][e];
+      if (in_band(combined)) oracle = std::min(oracle, eq9(p, combined, c.target, sp));
+    }
+    EXPECT_TRUE(in_band(kept));
+    EXPECT_NEAR(eq9(p, kept, c.target, sp), oracle, 1e-9) << "target " << c.target;
+    EXPECT_LE(eq9(p, kept, c.target, sp), eq9(p, x, c.target, sp) + 1e-9);
+    EXPECT_TRUE(eq4_holds(p, kept));
+    EXPECT_TRUE(eq8_holds(p, kept));
+    below_all += eq9(p, kept, c.target, sp) < best_given - 1e-9;
+    ++cases;
+  }
+  EXPECT_GE(cases, 3);
+  EXPECT_GE(below_all, 1) << "X was never reassembled below the selections it was split over";
 }

@@ -41,7 +41,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   SimplifyOptions& p = opt->pipeline;
   sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget in seconds (0 = greedy selection only)")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Solver");
-  sub->add_option("--threads", p.threads, "Solver threads: CBC's tree search, and as many annealing chains (best kept) in the fast selection (0 = all cores)")
+  sub->add_option("--threads", p.threads, "Solver threads: CBC's tree search, and the threads of annealing runs in the fast selection (0 = all cores)")
       ->check(CLI::Range(0, 256))->capture_default_str()->group("Solver");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Solver");
   sub->add_option("--formulation", opt->formulation, "fast, or exact (the paper's model as written)")

@@ -36,7 +36,7 @@ struct SimplifyOptions {
 
   // --- solver -----------------------------------------------------------------------------------
   double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only
-  int threads = 1;                  ///< solver threads (CBC; annealing chains of the fast selection); 0 = all cores
+  int threads = 0;                  ///< solver threads (CBC; annealing runs of the fast selection); 0 = all cores
   std::uint32_t seed = 1;
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
   /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).

@@ -1368,6 +1368,7 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
 struct AnnealStats {
   std::int64_t moves = 0, accepted = 0, compounds = 0;  // compounds: compound moves accepted
   bool schedule_done = false;  // ended by its move count, not by the time
+  int runs = 0;                // annealing runs (anneal_runs)
 };
 
 std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
@@ -1574,58 +1575,8 @@ std::vector<std::uint8_t> anneal_chain(const Groups& g, const GroupConstraints& 
   return best;
 }
 
-// Independent annealing chains, one per thread (seeds solve.seed, solve.seed + 1, …), each from
-// the same start for the same time; the selection with the lowest Eq. 9 wins (ties: the lowest
-// seed), so the result does not depend on which thread finishes first. One thread = anneal().
-// On 2 cores this is a best-of-two; it cannot make a chain longer.
-std::vector<std::uint8_t> anneal_chains(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
-                                        std::vector<std::uint8_t> y, std::uint64_t target,
-                                        const SelectionParams& params, double seconds,
-                                        const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
-                                        int chains, AnnealStats& stats) {
-  if (chains <= 1) return anneal_chain(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats);
-  std::vector<std::vector<std::uint8_t>> results(chains);
-  std::vector<AnnealStats> chain_stats(chains);
-  std::vector<std::thread> workers;
-  for (int k = 0; k < chains; ++k)
-    workers.emplace_back([&, k] {
-      SelectionParams p = params;
-      p.solve.seed = params.solve.seed + static_cast<std::uint32_t>(k);
-      results[k] = anneal_chain(g, gc, fg, y, target, p, seconds, adj_offsets, adjacent, chain_stats[k]);
-    });
-  for (std::thread& w : workers) w.join();
-  int best = 0;
-  double best_value = INFINITY;
-  for (int k = 0; k < chains; ++k) {
-    const double value = group_objective(g, gc, fg, results[k], target, params);
-    if (value < best_value) best_value = value, best = k;
-  }
-  stats = {};
-  for (const AnnealStats& cs : chain_stats) {
-    stats.moves += cs.moves;
-    stats.accepted += cs.accepted;
-    stats.compounds += cs.compounds;
-  }
-  stats.schedule_done = chain_stats[best].schedule_done;
-  return std::move(results[best]);
-}
-
-// ------------------------------------------------------------------------------------------
-// Recombination of independent parts (beyond the paper; docs/formulation.md, "Speed"). The free
-// groups fall into components that share no term of Eq. 9 and no constraint: two free groups are
-// in one component if they share a face (t_f), an Eq. 6 cluster, an Eq. 7 cluster or an Eq. 8
-// pair of clusters (split pairs share a face). Only the count row |N' − N| (Eqs. 1–2) couples the
-// components, so Eq. 9 = |Σ_c N'_c + N'_fixed − N| + Σ_c cost_c(y_c). A price μ per
-// triangle-equivalent in place of the count term makes the problem separable (a Lagrangian
-// relaxation of Eq. 1): a descent on cost + μ N' from the incumbent improves every component on
-// its own. Each price's end state offers every component an alternative (ΔN'_c, Δcost_c); a
-// multiple-choice knapsack over the count offset (a dynamic programme over N' − N within Eq. 2's
-// band) then picks one alternative per component (or its incumbent) minimising Eq. 9 exactly.
-// A component collapsing a chord at a loss of less than a triangle-equivalent per removed one
-// can so be paired with a component keeping a chord elsewhere for more than that — a pair the
-// count term's price of 1 in both directions hides from every single move and from regions that
-// do not hold both parts. c172p (an aircraft of many separate parts) has 968 components, the
-// largest of 554 of its 22 131 free groups.
+// The components of the free groups that share no term of Eq. 9 and no constraint (the
+// recombination below explains why only the count row couples them).
 struct FreeComponents {
   Index count = 0;
   std::vector<Index> of_group;         // kInvalidIndex for fixed groups
@@ -1674,6 +1625,104 @@ FreeComponents free_components(const Groups& g, const GroupConstraints& gc, cons
     if (fc.of_group[x] != kInvalidIndex) fc.groups[fill[fc.of_group[x]]++] = x;
   return fc;
 }
+
+// Annealing runs on `threads` threads (issue 4; docs/formulation.md, "Speed"). Each thread runs
+// annealing chains one after the other from the same start: params.anneal_runs of them, each an
+// equal share of what is left of its time, and more while at least half the last run's time is
+// left (a schedule that ends by its move count leaves time: small meshes, long budgets), up to
+// params.anneal_max_runs per thread. Run i
+// (in the order thread 0's first, thread 1's first, …, thread 0's second, …) has seed
+// solve.seed + i. The run with the lowest Eq. 9 is returned (ties: the lowest seed); the others,
+// best first, go to `alternatives` (at most params.anneal_max_alternatives): the recombination
+// takes each independent component from whichever run did best there. On c172p the runs end
+// 5-10 % apart in Eq. 9, but not in the same components, so the combination lies below every
+// run; one long run per thread, whose results only compete as a best-of-k, ends higher.
+std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                      std::vector<std::uint8_t> y, std::uint64_t target,
+                                      const SelectionParams& params, double seconds,
+                                      const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
+                                      int threads, AnnealStats& stats,
+                                      std::vector<std::vector<std::uint8_t>>* alternatives) {
+  threads = std::max(threads, 1);
+  // Runs split a thread's time only where the recombination can combine them: with one component
+  // holding most free groups they only compete as a best-of-n, and one longer run does better
+  // (assimp_suzanne_subdiv, one component, 0.4, 5 s, 2 threads: Eq. 9 -10 263.7 with 2 runs per
+  // thread against -10 288.2 for one).
+  int planned = std::max(params.anneal_runs, 1);
+  if (planned > 1) {
+    const FreeComponents fc = free_components(g, gc, fg);
+    Index largest = 0;
+    for (Index c = 0; c < fc.count; ++c) largest = std::max(largest, fc.offsets[c + 1] - fc.offsets[c]);
+    if (double(largest) > params.anneal_runs_max_share * double(fc.offsets.back())) planned = 1;
+  }
+  Stopwatch clock;
+  struct Run {
+    std::uint32_t index;  // seed offset
+    double value;
+    std::vector<std::uint8_t> y;
+    AnnealStats stats;
+  };
+  std::vector<std::vector<Run>> runs(static_cast<std::size_t>(threads));
+  auto work = [&](int k) {
+    double last = 0.0;
+    for (int r = 0;; ++r) {
+      const double left = seconds - clock.seconds();
+      if (left <= 0.0 || r >= params.anneal_max_runs || (r >= planned && left < 0.5 * last)) break;
+      Run run;
+      run.index = static_cast<std::uint32_t>(r * threads + k);
+      SelectionParams p = params;
+      p.solve.seed = params.solve.seed + run.index;
+      Stopwatch run_clock;
+      run.y = anneal_chain(g, gc, fg, y, target, p, left / double(std::max(1, planned - r)), adj_offsets, adjacent,
+                           run.stats);
+      last = run_clock.seconds();
+      run.value = group_objective(g, gc, fg, run.y, target, params);
+      runs[std::size_t(k)].push_back(std::move(run));
+    }
+  };
+  if (threads == 1) {
+    work(0);
+  } else {
+    std::vector<std::thread> workers;
+    for (int k = 0; k < threads; ++k) workers.emplace_back(work, k);
+    for (std::thread& w : workers) w.join();
+  }
+  std::vector<Run> all;
+  for (auto& thread_runs : runs)
+    for (Run& run : thread_runs) all.push_back(std::move(run));
+  stats = {};
+  if (all.empty()) return y;
+  std::sort(all.begin(), all.end(),
+            [](const Run& a, const Run& b) { return a.value < b.value || (a.value == b.value && a.index < b.index); });
+  for (const Run& run : all) {
+    stats.moves += run.stats.moves;
+    stats.accepted += run.stats.accepted;
+    stats.compounds += run.stats.compounds;
+  }
+  stats.runs = static_cast<int>(all.size());
+  stats.schedule_done = all.front().stats.schedule_done;
+  if (alternatives)
+    for (std::size_t i = 1; i < all.size() && alternatives->size() < params.anneal_max_alternatives; ++i)
+      alternatives->push_back(std::move(all[i].y));
+  return std::move(all.front().y);
+}
+
+// ------------------------------------------------------------------------------------------
+// Recombination of independent parts (beyond the paper; docs/formulation.md, "Speed"). The free
+// groups fall into components that share no term of Eq. 9 and no constraint: two free groups are
+// in one component if they share a face (t_f), an Eq. 6 cluster, an Eq. 7 cluster or an Eq. 8
+// pair of clusters (split pairs share a face). Only the count row |N' − N| (Eqs. 1–2) couples the
+// components, so Eq. 9 = |Σ_c N'_c + N'_fixed − N| + Σ_c cost_c(y_c). A price μ per
+// triangle-equivalent in place of the count term makes the problem separable (a Lagrangian
+// relaxation of Eq. 1): a descent on cost + μ N' from the incumbent improves every component on
+// its own. Each price's end state offers every component an alternative (ΔN'_c, Δcost_c); a
+// multiple-choice knapsack over the count offset (a dynamic programme over N' − N within Eq. 2's
+// band) then picks one alternative per component (or its incumbent) minimising Eq. 9 exactly.
+// A component collapsing a chord at a loss of less than a triangle-equivalent per removed one
+// can so be paired with a component keeping a chord elsewhere for more than that — a pair the
+// count term's price of 1 in both directions hides from every single move and from regions that
+// do not hold both parts. c172p (an aircraft of many separate parts) has 968 components, the
+// largest of 554 of its 22 131 free groups.
 
 // Per component: its N'_c (faces with a free group in it) and cost_c (Eq. 9 without the count
 // term: λ_edge, λ_geo and λ_tri terms of its groups, clusters and split pairs).
@@ -1754,17 +1803,20 @@ std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConst
                                                std::vector<std::uint8_t> y, std::uint64_t target,
                                                const SelectionParams& params, double seconds,
                                                const std::vector<Index>& adj_offsets,
-                                               const std::vector<Index>& adjacent, RecombineStats& stats) {
+                                               const std::vector<Index>& adjacent, RecombineStats& stats,
+                                               const std::vector<std::vector<std::uint8_t>>& alternatives = {}) {
   Stopwatch clock;
   const FreeComponents fc = free_components(g, gc, fg);
   stats.components = fc.count;
   const std::vector<double>& prices = params.recombination_prices;
-  if (fc.count == 0 || prices.empty()) return y;
+  if (fc.count == 0 || (prices.empty() && alternatives.empty())) return y;
   const auto n = static_cast<std::int64_t>(target);
   const auto band = static_cast<std::int64_t>(std::floor(params.epsilon_n * double(target)));
   std::vector<std::int64_t> count0, count1;
   std::vector<double> cost0, cost1;
-  std::vector<std::vector<std::uint8_t>> states(prices.size());
+  // The alternatives (other annealing runs), then the end states of the priced descents; an
+  // option names its state in a byte.
+  std::vector<std::vector<std::uint8_t>> states(std::min<std::size_t>(alternatives.size() + prices.size(), 255));
   struct Option {
     std::int64_t dc;
     double dcost;
@@ -1787,11 +1839,15 @@ std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConst
     // from there: keeping a group always gains λ_edge Q), ±1 near the band's edges, where one
     // direction is closed (cg57 sits on the upper edge); the prices are offsets from it.
     const double slope = 2 * std::abs(total - n) > band ? (total > n ? 1.0 : -1.0) : 0.0;
-    for (std::size_t k = 0; k < prices.size() && clock.seconds() < seconds; ++k) {
-      const double price = slope + (slope < 0.0 ? -prices[k] : prices[k]);
-      SelectionState st(g, gc, fg, y);
-      priced_descent(st, g, gc, price, params, adj_offsets, adjacent, clock, seconds);
-      states[k] = std::move(st.y);
+    for (std::size_t k = 0; k < states.size() && clock.seconds() < seconds; ++k) {
+      if (k < alternatives.size()) {
+        states[k] = alternatives[k];
+      } else {
+        const double mu = prices[k - alternatives.size()];
+        SelectionState st(g, gc, fg, y);
+        priced_descent(st, g, gc, slope + (slope < 0.0 ? -mu : mu), params, adj_offsets, adjacent, clock, seconds);
+        states[k] = std::move(st.y);
+      }
       component_totals(g, gc, fg, fc, states[k], params, count1, cost1);
       for (Index c = 0; c < fc.count; ++c) {
         const std::int64_t dc = count1[c] - count0[c];
@@ -1806,8 +1862,17 @@ std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConst
     // The programme (also when the time cut the descents short: every state they reached is a
     // valid alternative, and the programme takes milliseconds): dp[s] = least Σ Δcost over the components so far with N' − N = s + lo; the
     // range covers Eq. 2's band and the incumbent's count (which may lie outside it: then any
-    // combination in the band is taken).
-    const std::int64_t d0 = total - n, lo = std::min(-band, d0), hi = std::max(band, d0);
+    // combination in the band is taken), widened by the largest |ΔN'| the components' options
+    // can add up to, so that partial sums outside the band that end inside it are not lost (the
+    // programme is then exact); the widening is capped at max(2 × band, 1 024) for memory.
+    std::int64_t reach = 0;
+    for (const auto& opts : options) {
+      std::int64_t most = 0;
+      for (const Option& o : opts) most = std::max(most, std::abs(o.dc));
+      reach += most;
+    }
+    reach = std::min(reach, std::max<std::int64_t>(2 * band, 1024));
+    const std::int64_t d0 = total - n, lo = std::min(-band, d0) - reach, hi = std::max(band, d0) + reach;
     const std::size_t width = std::size_t(hi - lo + 1);
     dp.assign(width, INFINITY);
     with_options.clear();
@@ -2094,19 +2159,21 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   // The greedy selection, polished by single flips and adjacent swaps, is the start of every
   // solve (skipped for a greedy-only run and when the greedy misses the band).
   std::vector<std::uint8_t> start_y = greedy.y;
+  std::vector<std::vector<std::uint8_t>> alternatives;  // other annealing runs, for the recombination
   if (reachable && time_limit > 0.0) {
     // Fast formulation: simulated annealing from the greedy selection until anneal_time_fraction
     // of the budget has passed, then the deterministic local search as a final descent.
     if (params.anneal_time_fraction > 0.0 && params.formulation == Formulation::Fast) {
       Stopwatch anneal_clock;
       AnnealStats as;
-      start_y = anneal_chains(groups, gc, fg, std::move(start_y), target, params,
-                              params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent,
-                              ilp::backend::resolve_threads(params.solve), as);
+      start_y = anneal_runs(groups, gc, fg, std::move(start_y), target, params,
+                            params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent,
+                            ilp::backend::resolve_threads(params.solve), as, &alternatives);
       result.anneal_moves = as.moves;
       result.anneal_accepted = as.accepted;
       result.anneal_compounds = as.compounds;
       result.anneal_converged = as.schedule_done;
+      result.anneal_runs = as.runs;
       result.seconds_anneal = anneal_clock.seconds();
     }
     // The recombination (after annealing only) takes its share from the end of the descent's.
@@ -2139,7 +2206,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       const std::vector<std::uint8_t> unrecombined = start_y;
       start_y = recombine_components(groups, gc, fg, std::move(start_y), target, params,
                                      params.descent_end_fraction * time_limit - clock.seconds(), adj_offsets,
-                                     adjacent, rs);
+                                     adjacent, rs, alternatives);
       result.recombination_rounds = rs.rounds;
       result.recombination_improved = rs.improved;
       result.recombination_moved = rs.moved;
@@ -2302,8 +2369,8 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
   group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
   AnnealStats as;
   if (params.anneal_time_fraction > 0.0)
-    p.y = anneal_chains(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent,
-                        ilp::backend::resolve_threads(params.solve), as);
+    p.y = anneal_runs(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent,
+                      ilp::backend::resolve_threads(params.solve), as, nullptr);
   FlipSearchStats stats;
   const std::vector<std::uint8_t> y =
       flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);
@@ -2314,13 +2381,16 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
 
 std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                     std::uint64_t target, const SelectionParams& params,
-                                    const std::vector<std::uint8_t>& edge_kept, Index* components) {
+                                    const std::vector<std::uint8_t>& edge_kept, Index* components,
+                                    const std::vector<std::vector<std::uint8_t>>& alternatives) {
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
   std::vector<Index> adj_offsets, adjacent;
   group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  std::vector<std::vector<std::uint8_t>> states;
+  for (const std::vector<std::uint8_t>& kept : alternatives) states.push_back(prepare(mesh, conn, analysis, params, kept).y);
   RecombineStats stats;
   const std::vector<std::uint8_t> y = recombine_components(p.groups, p.gc, p.fg, std::move(p.y), target, params,
-                                                           INFINITY, adj_offsets, adjacent, stats);
+                                                           INFINITY, adj_offsets, adjacent, stats, states);
   if (components) *components = stats.components;
   std::vector<std::uint8_t> kept(conn.num_edges);
   for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];

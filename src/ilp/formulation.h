@@ -182,6 +182,17 @@ struct SelectionParams {
   /// keep the lower Eq. 9: on short schedules the continuation can end above the plain annealing
   /// (docs/formulation.md, "Speed").
   bool anneal_plain_when_short = true;
+  /// Annealing runs per thread (docs/formulation.md, "Speed"), one after the other from the same
+  /// start, each an equal share of the thread's time left; more run while at least half the last
+  /// run's time is left, up to anneal_max_runs per thread. The best run is the incumbent; up to
+  /// anneal_max_alternatives others are offered to the recombination, which may take each
+  /// independent component from any of them.
+  int anneal_runs = 2;
+  /// anneal_runs applies only when no independent component holds more than this share of the
+  /// free groups; otherwise one run per thread (plus the extra ones).
+  double anneal_runs_max_share = 0.5;
+  int anneal_max_runs = 32;
+  std::size_t anneal_max_alternatives = 64;
   bool quiet = true;  ///< progress lines on stderr when false
 };
 
@@ -237,6 +248,7 @@ struct SelectionResult {
   double seconds_flip_search = 0.0;
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
   double seconds_anneal = 0.0;
+  int anneal_runs = 0;                  ///< annealing runs, over all threads
   Index components = 0;                 ///< independent parts (components of the free groups)
   Index recombination_rounds = 0, recombination_improved = 0, recombination_moved = 0;
   double seconds_recombination = 0.0;
@@ -301,10 +313,13 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
 /// The recombination of independent parts of select_edges() alone (no annealing, no descent),
 /// from the selection `edge_kept` (uniform per group, N' in Eq. 2's band), for
 /// params.recombination_rounds rounds or until a round gains nothing; returns the edge bits it
-/// ends at. `components`, if given, receives the number of independent parts.
+/// ends at. `components`, if given, receives the number of independent parts. `alternatives`
+/// (edge bits, uniform per group, as other annealing runs give) are offered besides the priced
+/// descents' end states.
 std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                     std::uint64_t target, const SelectionParams& params,
-                                    const std::vector<std::uint8_t>& edge_kept, Index* components = nullptr);
+                                    const std::vector<std::uint8_t>& edge_kept, Index* components = nullptr,
+                                    const std::vector<std::vector<std::uint8_t>>& alternatives = {});
 
 }  // namespace detail
 

@@ -128,6 +128,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"seconds_solve", s.seconds_solve},
       {"stop_reason", s.stop_reason},
       {"anneal_converged", s.anneal_converged},
+      {"anneal_runs", s.anneal_runs},
       {"flip_search_converged", s.flip_search_converged},
   };
   if (s.solver_ran) {
@@ -643,7 +644,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"lambda_edge", sp.lambda_edge},
       {"lambda_tri", sp.lambda_tri},
       {"time_limit_seconds", options.time_limit_seconds},
-      {"threads", options.threads},
+      {"threads", ilp::backend::resolve_threads(sp.solve)},  // 0 (all cores) resolved
       {"seed", options.seed},
       {"formulation", options.exact_formulation ? "exact" : "fast"},
       {"strategy", options.strategy},
