@@ -3,7 +3,7 @@
 For every mesh × ratio × formulation × time limit it runs
     quadlod -q simplify MESH -o OUT --ratio R --time-limit S --max-rounds 1 --max-passes 1 --no-greedy-fallback
             --formulation F
-            --threads 1 --report REPORT [extra args]
+            --threads T --report REPORT [extra args]
 one at a time (the machine is shared: timings are wall clock), and reads report.selection.
 Reports are kept in --out and reused (delete them to re-run). The gap of a run is
 (objective − best) / (best − baseline), best = the lowest objective of any run on that mesh and
@@ -43,6 +43,7 @@ def main():
     ap.add_argument("--tag", default="", help="suffix of the report names (to keep variants apart); "
                     "comma-separated to tabulate several variants together, e.g. ',_v2' (the best "
                     "of a mesh is then the best of every variant)")
+    ap.add_argument("--threads", default="0", help="quadlod simplify --threads (0 = all cores, quadlod's default)")
     ap.add_argument("--skip-missing", action="store_true", help="tabulate existing reports, run nothing")
     ap.add_argument("extra", nargs="*", help="more simplify arguments, after --")
     a = ap.parse_args()
@@ -67,7 +68,7 @@ def main():
                         load = open("/proc/loadavg").read().split()[0]
                         cmd = [a.quadlod, "-q", "simplify", src, "-o", os.path.join(a.out, name + ".obj"),
                                "--ratio", ratio, "--time-limit", limit, "--max-rounds", "1",
-                               "--max-passes", "1", "--no-greedy-fallback", "--formulation", form, "--threads", "1", "--report", report] + a.extra
+                               "--max-passes", "1", "--no-greedy-fallback", "--formulation", form, "--threads", a.threads, "--report", report] + a.extra
                         print("running:", " ".join(cmd), file=sys.stderr, flush=True)
                         t = time.time()
                         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)

@@ -1645,9 +1645,13 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
                                       std::vector<std::vector<std::uint8_t>>* alternatives) {
   threads = std::max(threads, 1);
   // Runs split a thread's time only where the recombination can combine them: with one component
-  // holding most free groups they only compete as a best-of-n, and one longer run does better
-  // (assimp_suzanne_subdiv, one component, 0.4, 5 s, 2 threads: Eq. 9 -10 263.7 with 2 runs per
-  // thread against -10 288.2 for one).
+  // holding most free groups they only compete as a best-of-n, and one longer run per thread is
+  // better (oakeshott_sword_quaddominant, 0.4, 5 s, 2 threads: Eq. 9 -1 849.3 with two runs per
+  // thread, -1 870.2, -1 898.4, -1 881.5 with one). The extra runs after schedules that end by
+  // their move count stay everywhere: on small meshes their best-of-n beats the neighbourhood
+  // MIPs that would get the time instead (5 s, 2 threads, with / without them: collada_duck
+  // 142.7 / 167.8, opensubdiv_bishop_cage 97.0 / 103.1, blender_suzanne 641.8 / 646.6;
+  // assimp_suzanne_subdiv is the exception, -10 263.7 / -10 288.2).
   int planned = std::max(params.anneal_runs, 1);
   if (planned > 1) {
     const FreeComponents fc = free_components(g, gc, fg);
@@ -1794,6 +1798,7 @@ void priced_descent(SelectionState& st, const Groups& g, const GroupConstraints&
 
 struct RecombineStats {
   Index rounds = 0, improved = 0, components = 0, moved = 0;
+  Index largest = 0;  // free groups of the largest component
 };
 
 // Rounds of: one priced descent per price from the incumbent, then the dynamic programme over
@@ -1808,6 +1813,7 @@ std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConst
   Stopwatch clock;
   const FreeComponents fc = free_components(g, gc, fg);
   stats.components = fc.count;
+  for (Index c = 0; c < fc.count; ++c) stats.largest = std::max(stats.largest, fc.offsets[c + 1] - fc.offsets[c]);
   const std::vector<double>& prices = params.recombination_prices;
   if (fc.count == 0 || (prices.empty() && alternatives.empty())) return y;
   const auto n = static_cast<std::int64_t>(target);
@@ -2211,6 +2217,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       result.recombination_improved = rs.improved;
       result.recombination_moved = rs.moved;
       result.components = rs.components;
+      result.largest_component = rs.largest;
       result.seconds_recombination = recombine_clock.seconds();
       result.recombination_gain = before - group_objective(groups, gc, fg, start_y, target, params);
       if (result.recombination_gain < -1e-6 * std::max(1.0, std::abs(before))) {  // never: the programme is exact

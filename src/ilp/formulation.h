@@ -250,6 +250,7 @@ struct SelectionResult {
   double seconds_anneal = 0.0;
   int anneal_runs = 0;                  ///< annealing runs, over all threads
   Index components = 0;                 ///< independent parts (components of the free groups)
+  Index largest_component = 0;          ///< free groups in the largest of them
   Index recombination_rounds = 0, recombination_improved = 0, recombination_moved = 0;
   double seconds_recombination = 0.0;
   double recombination_gain = 0.0;      ///< Eq. 9 lowered by the recombination (before the second descent)
