@@ -191,6 +191,9 @@ struct SelectionParams {
   /// anneal_runs applies only when no independent component holds more than this share of the
   /// free groups; otherwise one run per thread (plus the extra ones).
   double anneal_runs_max_share = 0.5;
+  /// Caps, not tuned: without them a small mesh with a long budget would run a schedule of
+  /// milliseconds thousands of times, and keep every result (c172p at 180 s ran 29 runs on 2
+  /// threads; an alternative costs one byte per group).
   int anneal_max_runs = 32;
   std::size_t anneal_max_alternatives = 64;
   bool quiet = true;  ///< progress lines on stderr when false
