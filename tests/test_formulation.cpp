@@ -686,3 +686,32 @@ TEST(Formulation, RecombinationTakesEachPartFromTheBestRun) {
   EXPECT_GE(cases, 3);
   EXPECT_GE(below_all, 1) << "X was never reassembled below the selections it was split over";
 }
+
+TEST(Formulation, AnnealingRunsSplitTheTimeOnlyWhenNoComponentDominates) {
+  // anneal_runs runs per thread when no independent component holds more than
+  // anneal_runs_max_share of the free groups (three copies of the mixed torus side by side), one
+  // run otherwise (the mixed torus alone: one component). Schedules end by the clock here (no
+  // move limit), so no extra runs follow; the report gives the components and the largest.
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_runs = 3;
+  sp.anneal_max_runs = 3;
+  sp.anneal_moves_per_group = 1e12;
+  sp.solve.time_limit_seconds = 0.6;
+  sp.solve.threads = 1;
+  const Prepared three =
+      prepare(two_parts(two_parts(mixed_torus(), mixed_torus(), Vec3(3.0, 0.0, 0.0)), mixed_torus(), Vec3(0.0, 3.0, 0.0)));
+  const Prepared one = prepare(mixed_torus());
+  for (const Prepared* p : {&three, &one}) {
+    const auto target = static_cast<std::uint64_t>(std::llround(0.6 * double(tri_equivalent_count(p->mesh))));
+    const SelectionResult r = select_edges(p->mesh, p->conn, p->analysis, target, sp);
+    ASSERT_GT(r.anneal_moves, 0);
+    const Index free_groups = r.model.edge_groups - r.model.fixed_kept_groups;
+    EXPECT_EQ(r.components, p == &three ? 3u : 1u);
+    EXPECT_GT(r.largest_component, 0u);
+    EXPECT_LE(r.largest_component, free_groups);
+    const bool dominated = double(r.largest_component) > sp.anneal_runs_max_share * double(free_groups);
+    EXPECT_EQ(dominated, p == &one);
+    EXPECT_EQ(r.anneal_runs, dominated ? 1 : 3);
+  }
+}

@@ -1074,6 +1074,50 @@ Index chain_walk(SelectionState& st, const Groups& g, const GroupConstraints& gc
   return applied;
 }
 
+// Swaps: keep a collapsed group b and collapse a kept neighbour a (one that shares a face), as
+// one move; per b the best a is taken if the pair lowers Eq. 9 and the new count is
+// `in_band`. As in chain_walk, `count_term(N')` stands for |N' − N| (the priced descent passes
+// μ N' and no band). With `keep_must_pay` a b whose own change without the count term does
+// not lower Eq. 9 is skipped: keeping it must pay for something besides the count. Returns the
+// number of swaps applied.
+template <class CountTerm, class InBand>
+Index swap_walk(SelectionState& st, const Groups& g, const SelectionParams& params, const std::vector<Index>& adj_offsets,
+                const std::vector<Index>& adjacent, const Stopwatch& clock, double seconds, CountTerm&& count_term,
+                InBand&& in_band, bool keep_must_pay) {
+  constexpr double eps = 1e-9;
+  Index applied = 0;
+  for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
+    if (g.fixed[b] || st.y[b]) continue;
+    const double rb = st.delta_rest(b, params);
+    if (keep_must_pay && rb >= 0.0) continue;
+    const std::int64_t before = st.count;
+    const std::int64_t db = st.delta_count(b);
+    st.flip(b, db);
+    Index best_a = kInvalidIndex;
+    std::int64_t best_da = 0;
+    double best_gain = -eps;
+    for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
+      const Index a = adjacent[k];
+      if (g.fixed[a] || !st.y[a] || !st.may_collapse(a)) continue;
+      const std::int64_t da = st.delta_count(a);
+      if (!in_band(st.count + da)) continue;
+      const double gain = count_term(st.count + da) - count_term(before) + rb + st.delta_rest(a, params);
+      if (gain < best_gain) {
+        best_gain = gain;
+        best_a = a;
+        best_da = da;
+      }
+    }
+    if (best_a != kInvalidIndex) {
+      st.flip(best_a, best_da);
+      ++applied;
+    } else {
+      st.flip(b, -db);  // undo
+    }
+  }
+  return applied;
+}
+
 bool chain_moves(SelectionState& st, const Groups& g, const GroupConstraints& gc, std::uint64_t target,
                  const SelectionParams& params, const Stopwatch& clock, double seconds, FlipSearchStats& stats) {
   const double n = double(target), band = params.epsilon_n * n;
@@ -1315,36 +1359,9 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
         improved = true;
       }
     }
-    // Swaps: keep b (collapsed) and collapse a neighbour a (kept), evaluated as one move.
-    for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
-      if (g.fixed[b] || st.y[b]) continue;
-      const double rb = st.delta_rest(b, params);
-      if (rb >= 0.0) continue;  // keeping b must pay for something besides the count
-      const std::int64_t before = st.count;
-      const std::int64_t db = st.delta_count(b);
-      st.flip(b, db);
-      Index best_a = kInvalidIndex;
-      std::int64_t best_da = 0;
-      double best_gain = -eps;
-      for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
-        const Index a = adjacent[k];
-        if (g.fixed[a] || !st.y[a] || !st.may_collapse(a)) continue;
-        const std::int64_t da = st.delta_count(a);
-        if (!in_band(st.count + da)) continue;
-        const double gain = count_term(st.count + da) - count_term(before) + rb + st.delta_rest(a, params);
-        if (gain < best_gain) {
-          best_gain = gain;
-          best_a = a;
-          best_da = da;
-        }
-      }
-      if (best_a != kInvalidIndex) {
-        st.flip(best_a, best_da);
-        ++stats.swaps;
-        improved = true;
-      } else {
-        st.flip(b, -db);  // undo
-      }
+    if (const Index swaps = swap_walk(st, g, params, adj_offsets, adjacent, clock, seconds, count_term, in_band, true)) {
+      stats.swaps += swaps;
+      improved = true;
     }
     if (params.chain_moves && clock.seconds() < seconds)
       improved |= chain_moves(st, g, gc, target, params, clock, seconds, stats);
@@ -1768,28 +1785,9 @@ void priced_descent(SelectionState& st, const Groups& g, const GroupConstraints&
         improved = true;
       }
     }
-    for (Index b = 0; b < g.count && clock.seconds() < seconds; ++b) {
-      if (g.fixed[b] || st.y[b]) continue;
-      const std::int64_t db = st.delta_count(b);
-      const double rb = st.delta_rest(b, params) + mu * double(db);
-      st.flip(b, db);
-      Index best_a = kInvalidIndex;
-      std::int64_t best_da = 0;
-      double best_gain = -eps;
-      for (Index k = adj_offsets[b]; k < adj_offsets[b + 1]; ++k) {
-        const Index a = adjacent[k];
-        if (g.fixed[a] || !st.y[a] || !st.may_collapse(a)) continue;
-        const std::int64_t da = st.delta_count(a);
-        const double gain = rb + st.delta_rest(a, params) + mu * double(da);
-        if (gain < best_gain) best_gain = gain, best_a = a, best_da = da;
-      }
-      if (best_a != kInvalidIndex) {
-        st.flip(best_a, best_da);
-        improved = true;
-      } else {
-        st.flip(b, -db);
-      }
-    }
+    improved |= swap_walk(
+                    st, g, params, adj_offsets, adjacent, clock, seconds, [&](std::int64_t c) { return mu * double(c); },
+                    [](std::int64_t) { return true; }, false) > 0;
     improved |= chain_walk(
                     st, g, gc, params, clock, seconds, [&](std::int64_t c) { return mu * double(c); },
                     [](std::int64_t) { return true; }) > 0;
