@@ -687,6 +687,64 @@ TEST(Formulation, RecombinationTakesEachPartFromTheBestRun) {
   EXPECT_GE(below_all, 1) << "X was never reassembled below the selections it was split over";
 }
 
+TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
+  // A priced run anneals cost + μ N' (Eq. 9 with the count term replaced by a price per
+  // triangle-equivalent, no band). On meshes small enough to enumerate every segment decision
+  // it must end at the brute-force optimum of that value (Eq. 8 kept), for prices from "keep
+  // everything" to "remove everything"; N' does not grow with the price.
+  PolyMesh folded = make_grid(3, 2, 3.0, 2.0);
+  for (Vec3& v : folded.positions)
+    if (v.x() > 1.0 + 1e-9) v = Vec3(1.0, v.y(), -(v.x() - 1.0));
+  folded.positions[0].z() += 0.2;
+  const Prepared grid = prepare(std::move(folded));
+  const Prepared cylinder = prepare(make_cylinder(6, 3));
+  SelectionParams sp;
+  sp.lambda_edge = 0.3;
+  sp.anneal_moves_per_group = 5000;
+  for (const Prepared* p : {&grid, &cylinder}) {
+    const std::uint64_t target = tri_equivalent_count(p->mesh) / 2;  // only the count term uses it
+    auto priced = [&](const std::vector<std::uint8_t>& kept, double mu) {
+      const double n = double(predicted_tri_equivalent(p->mesh, p->conn, kept));
+      return eq9(*p, kept, target, sp) - std::abs(n - double(target)) + mu * n;
+    };
+    std::vector<std::vector<Index>> units;
+    std::vector<bool> covered(p->conn.num_edges, false);
+    for (const Segment& s : p->analysis.segmentation.segments) {
+      units.push_back(s.opposing_edges);
+      for (Index e : s.opposing_edges) covered[e] = true;
+    }
+    for (Index e = 0; e < p->conn.num_edges; ++e)
+      if (!covered[e]) units.push_back({e});
+    ASSERT_LE(units.size(), 20u) << "oracle too large";
+    std::set<std::uint64_t> counts;
+    std::uint64_t last_count = ~std::uint64_t{0};
+    for (double mu : {0.05, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 6.0}) {
+      double best = INFINITY;
+      std::uint64_t best_count = 0;
+      for (std::uint32_t mask = 0; mask < (1u << units.size()); ++mask) {
+        std::vector<std::uint8_t> kept(p->conn.num_edges, 1);
+        for (std::size_t u = 0; u < units.size(); ++u)
+          if (!(mask >> u & 1))
+            for (Index e : units[u]) kept[e] = 0;
+        if (!eq8_holds(*p, kept)) continue;
+        if (const double v = priced(kept, mu); v < best - 1e-9)
+          best = v, best_count = predicted_tri_equivalent(p->mesh, p->conn, kept);
+      }
+      const std::vector<std::uint8_t> all(p->conn.num_edges, 1);
+      const auto kept = detail::priced_anneal(p->mesh, p->conn, p->analysis, target, sp, all, mu, 600.0);
+      EXPECT_NEAR(priced(kept, mu), best, 1e-9) << "price " << mu;
+      EXPECT_TRUE(eq4_holds(*p, kept));
+      EXPECT_TRUE(eq8_holds(*p, kept));
+      const std::uint64_t n = predicted_tri_equivalent(p->mesh, p->conn, kept);
+      EXPECT_LE(n, last_count) << "price " << mu;
+      last_count = n;
+      counts.insert(best_count);
+    }
+    // The folded grid goes 8 → 4 → 1 → 0 triangle-equivalents; the cylinder keeps all or nothing.
+    EXPECT_GE(counts.size(), p == &grid ? 4u : 2u) << "the prices do not lead to different selections";
+  }
+}
+
 TEST(Formulation, AnnealingRunsSplitTheTimeOnlyWhenNoComponentDominates) {
   // anneal_runs runs per thread when no independent component holds more than
   // anneal_runs_max_share of the free groups (three copies of the mixed torus side by side), one
@@ -713,5 +771,6 @@ TEST(Formulation, AnnealingRunsSplitTheTimeOnlyWhenNoComponentDominates) {
     const bool dominated = double(r.largest_component) > sp.anneal_runs_max_share * double(free_groups);
     EXPECT_EQ(dominated, p == &one);
     EXPECT_EQ(r.anneal_runs, dominated ? 1 : 3);
+    EXPECT_EQ(r.anneal_priced_runs, dominated ? 0 : 1);  // the second of three
   }
 }

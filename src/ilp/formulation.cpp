@@ -979,13 +979,19 @@ Index count_collapsed_clusters(const GroupConstraints& gc, const std::vector<std
   return n;
 }
 
+// N' (Eq. 1) of y.
+std::uint64_t selection_count(const FaceGroups& fg, const std::vector<std::uint8_t>& y) {
+  std::uint64_t count = 0;
+  for (Index f = 0; f + 1 < fg.offsets.size(); ++f) count += face_count(fg, f, y);
+  return count;
+}
+
 // Eq. 9 in group space — what the banded fast model evaluates to for the completion of y:
 // |N' − N| + λ_geo · (clusters with every group collapsed) − λ_edge · Σ Q̂ y.
 double group_objective(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
                        const std::vector<std::uint8_t>& y, std::uint64_t target,
                        const SelectionParams& params) {
-  std::uint64_t count = 0;
-  for (Index f = 0; f + 1 < fg.offsets.size(); ++f) count += face_count(fg, f, y);
+  const std::uint64_t count = selection_count(fg, y);
   double importance = 0.0;
   for (Index grp = 0; grp < g.count; ++grp) importance += y[grp] * g.importance[grp];
   double split = 0.0;
@@ -1382,21 +1388,30 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
 // or anneal_moves_per_group moves per free group, whichever ends first). The
 // best selection seen is returned. Microseconds per move, so millions of moves fit where the
 // neighbourhood MIPs manage a few hundred; the MIPs then polish its result.
+//
+// A priced run (`price` set) anneals cost + μ N' instead: the count term of Eq. 9 replaced by a
+// price μ per triangle-equivalent, with no band and no continuation, which makes every
+// independent component a problem of its own (the Lagrangian relaxation the recombination
+// uses). Its end state lies anywhere in N' and is only an alternative for the recombination.
 struct AnnealStats {
   std::int64_t moves = 0, accepted = 0, compounds = 0;  // compounds: compound moves accepted
   bool schedule_done = false;  // ended by its move count, not by the time
   int runs = 0;                // annealing runs (anneal_runs)
+  int priced_runs = 0;         // of which priced
 };
 
 std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
                                  std::vector<std::uint8_t> y, std::uint64_t target, const SelectionParams& params,
                                  double seconds, const std::vector<Index>& adj_offsets,
-                                 const std::vector<Index>& adjacent, AnnealStats& stats) {
+                                 const std::vector<Index>& adjacent, AnnealStats& stats,
+                                 std::optional<double> price = std::nullopt) {
   Stopwatch clock;
   SelectionState st(g, gc, fg, std::move(y));
   const double n = double(target), band = params.epsilon_n * n;
-  auto count_term = [&](std::int64_t c) { return std::abs(double(c) - n); };
-  auto in_band = [&](std::int64_t c) { return std::abs(double(c) - n) <= band; };
+  const bool priced = price.has_value();
+  const double mu = price.value_or(0.0);
+  auto count_term = [&](std::int64_t c) { return priced ? mu * double(c) : std::abs(double(c) - n); };
+  auto in_band = [&](std::int64_t c) { return priced || std::abs(double(c) - n) <= band; };
   std::vector<Index> movable;
   for (Index grp = 0; grp < g.count; ++grp)
     if (!g.fixed[grp]) movable.push_back(grp);
@@ -1415,12 +1430,12 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   // term weighs w0 and N' may leave Eq. 2's band by band_relax × the band; over the ramp both go
   // linearly to the true objective and the hard band, the excess beyond the band penalised by
   // band_penalty × ramp per triangle-equivalent.
-  const double w0 = params.anneal_count_weight, band_relax = params.anneal_band_relax;
+  const double w0 = priced ? 1.0 : params.anneal_count_weight, band_relax = params.anneal_band_relax;
   const double rho_max = params.anneal_band_penalty;
   const double count_ramp_start = params.anneal_ramp_start, count_ramp_end = params.anneal_ramp_end;
   double count_weight = w0;
   double ramp = 0.0;  // 0 before the ramp, 1 after it
-  auto outside = [&](std::int64_t c) { return std::max(0.0, std::abs(double(c) - n) - band); };
+  auto outside = [&](std::int64_t c) { return priced ? 0.0 : std::max(0.0, std::abs(double(c) - n) - band); };
   auto annealed = [&](double delta, std::int64_t c0, std::int64_t c1) {
     return delta - (1.0 - count_weight) * (count_term(c1) - count_term(c0)) +
            rho_max * ramp * (outside(c1) - outside(c0));
@@ -1472,7 +1487,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
     }
   };
   CompoundScratch compound;
-  const double compound_share = params.compound_moves ? params.anneal_compound_share : 0.0;
+  // (compound moves judge Eq. 9's count term themselves: not in priced runs)
+  const double compound_share = params.compound_moves && !priced ? params.anneal_compound_share : 0.0;
   // The schedule runs on time or on moves, whichever ends first (small meshes: moves).
   const double max_moves = params.anneal_moves_per_group * double(movable.size());
   for (;; ++stats.moves) {
@@ -1569,12 +1585,13 @@ std::vector<std::uint8_t> anneal_chain(const Groups& g, const GroupConstraints& 
                                        std::vector<std::uint8_t> y, std::uint64_t target,
                                        const SelectionParams& params, double seconds,
                                        const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
-                                       AnnealStats& stats) {
+                                       AnnealStats& stats, std::optional<double> price = std::nullopt) {
   Stopwatch clock;
-  const bool continuation =
-      params.anneal_plain_when_short && (params.anneal_count_weight != 1.0 || params.anneal_band_relax != 0.0);
+  const bool continuation = !price && params.anneal_plain_when_short &&
+                            (params.anneal_count_weight != 1.0 || params.anneal_band_relax != 0.0);
   std::vector<std::uint8_t> start = continuation ? y : std::vector<std::uint8_t>{};
-  std::vector<std::uint8_t> best = anneal(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats);
+  std::vector<std::uint8_t> best =
+      anneal(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats, price);
   if (!continuation || !stats.schedule_done || clock.seconds() >= 0.5 * seconds) return best;
   SelectionParams plain = params;
   plain.anneal_count_weight = 1.0;
@@ -1653,7 +1670,8 @@ FreeComponents free_components(const Groups& g, const GroupConstraints& gc, cons
 // best first, go to `alternatives` (at most params.anneal_max_alternatives): the recombination
 // takes each independent component from whichever run did best there. On c172p the runs end
 // 5-10 % apart in Eq. 9, but not in the same components, so the combination lies below every
-// run; one long run per thread, whose results only compete as a best-of-k, ends higher.
+// run; one long run per thread, whose results only compete as a best-of-k, ends higher. Every
+// other run is a priced one where runs are recombined (below; SelectionParams::anneal_prices).
 std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
                                       std::vector<std::uint8_t> y, std::uint64_t target,
                                       const SelectionParams& params, double seconds,
@@ -1679,13 +1697,22 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
   Stopwatch clock;
   struct Run {
     std::uint32_t index;  // seed offset
-    double value;
+    bool priced = false;
+    double value;         // Eq. 9; INFINITY for a priced run (never the incumbent)
     std::vector<std::uint8_t> y;
     AnnealStats stats;
   };
   std::vector<std::vector<Run>> runs(static_cast<std::size_t>(threads));
+  // Where the runs are recombined, every other run of a thread (its second, fourth, …) is a
+  // priced one, at a price of the count term's slope at the thread's first run (0 inside the
+  // band's middle, ±1 near its edges, as in the recombination) plus the next offset of
+  // anneal_prices (mirrored below the band), so that each component also offers states at the
+  // exchange rates of triangle-equivalents against Eq. 9's other terms.
+  const bool priced_runs = planned > 1 && !params.anneal_prices.empty();
+  const auto band = static_cast<std::int64_t>(std::floor(params.epsilon_n * double(target)));
   auto work = [&](int k) {
     double last = 0.0;
+    double slope = 0.0;
     for (int r = 0;; ++r) {
       const double left = seconds - clock.seconds();
       if (left <= 0.0 || r >= params.anneal_max_runs || (r >= planned && left < 0.5 * last)) break;
@@ -1693,11 +1720,23 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
       run.index = static_cast<std::uint32_t>(r * threads + k);
       SelectionParams p = params;
       p.solve.seed = params.solve.seed + run.index;
+      std::optional<double> price;
+      if (priced_runs && r % 2 == 1) {
+        // priced runs in the order thread 0's first, thread 1's first, …
+        const auto i = std::size_t(r / 2) * std::size_t(threads) + std::size_t(k);
+        const double offset = params.anneal_prices[i % params.anneal_prices.size()];
+        price = slope + (slope < 0.0 ? -offset : offset);
+      }
       Stopwatch run_clock;
       run.y = anneal_chain(g, gc, fg, y, target, p, left / double(std::max(1, planned - r)), adj_offsets, adjacent,
-                           run.stats);
+                           run.stats, price);
       last = run_clock.seconds();
-      run.value = group_objective(g, gc, fg, run.y, target, params);
+      run.priced = price.has_value();
+      run.value = run.priced ? INFINITY : group_objective(g, gc, fg, run.y, target, params);
+      if (r == 0) {
+        const auto d = static_cast<std::int64_t>(selection_count(fg, run.y)) - static_cast<std::int64_t>(target);
+        slope = 2 * std::abs(d) > band ? (d > 0 ? 1.0 : -1.0) : 0.0;
+      }
       runs[std::size_t(k)].push_back(std::move(run));
     }
   };
@@ -1716,6 +1755,7 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
   std::sort(all.begin(), all.end(),
             [](const Run& a, const Run& b) { return a.value < b.value || (a.value == b.value && a.index < b.index); });
   for (const Run& run : all) {
+    stats.priced_runs += run.priced;
     stats.moves += run.stats.moves;
     stats.accepted += run.stats.accepted;
     stats.compounds += run.stats.compounds;
@@ -2178,6 +2218,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       result.anneal_compounds = as.compounds;
       result.anneal_converged = as.schedule_done;
       result.anneal_runs = as.runs;
+      result.anneal_priced_runs = as.priced_runs;
       result.seconds_anneal = anneal_clock.seconds();
     }
     // The recombination (after annealing only) takes its share from the end of the descent's.
@@ -2379,6 +2420,20 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
   FlipSearchStats stats;
   const std::vector<std::uint8_t> y =
       flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);
+  std::vector<std::uint8_t> kept(conn.num_edges);
+  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
+  return kept;
+}
+
+std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                        std::uint64_t target, const SelectionParams& params,
+                                        const std::vector<std::uint8_t>& edge_kept, double price, double seconds) {
+  Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  std::vector<Index> adj_offsets, adjacent;
+  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  AnnealStats as;
+  const std::vector<std::uint8_t> y =
+      anneal_chain(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as, price);
   std::vector<std::uint8_t> kept(conn.num_edges);
   for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
   return kept;

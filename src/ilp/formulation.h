@@ -188,6 +188,12 @@ struct SelectionParams {
   /// anneal_max_alternatives others are offered to the recombination, which may take each
   /// independent component from any of them.
   int anneal_runs = 2;
+  /// Priced runs (docs/formulation.md, "Speed"): where the runs are recombined, every thread's
+  /// second, fourth, … run anneals cost + μ N' (Eq. 9 with the count term replaced by a price μ
+  /// per triangle-equivalent) for μ = the count term's slope at the thread's first run (0, or ±1
+  /// near the band's edges) plus the next of these offsets (mirrored below the band), and is
+  /// only an alternative for the recombination. Empty = no priced runs.
+  std::vector<double> anneal_prices = {0.25, 0.4, 0.15, 0.3};
   /// anneal_runs applies only when no independent component holds more than this share of the
   /// free groups; otherwise one run per thread (plus the extra ones).
   double anneal_runs_max_share = 0.5;
@@ -252,6 +258,7 @@ struct SelectionResult {
   std::int64_t anneal_moves = 0, anneal_accepted = 0;  ///< simulated annealing moves tried / taken
   double seconds_anneal = 0.0;
   int anneal_runs = 0;                  ///< annealing runs, over all threads
+  int anneal_priced_runs = 0;           ///< of which priced (SelectionParams::anneal_prices)
   Index components = 0;                 ///< independent parts (components of the free groups)
   Index largest_component = 0;          ///< free groups in the largest of them
   Index recombination_rounds = 0, recombination_improved = 0, recombination_moved = 0;
@@ -313,6 +320,14 @@ ilp::Model neighbourhood_model(const PolyMesh& mesh, const Connectivity& conn, c
 std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                        std::uint64_t target, const SelectionParams& params,
                                        const std::vector<std::uint8_t>& edge_kept, double seconds);
+
+/// One priced annealing run (SelectionParams::anneal_prices) from the selection `edge_kept`
+/// (uniform per group, Eq. 8 kept): annealing on cost + price × N' (Eq. 9 with the count term
+/// replaced by the price; no band) for params.anneal_moves_per_group moves per free group or
+/// `seconds`, whichever ends first; returns the edge bits of the lowest value it met.
+std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                        std::uint64_t target, const SelectionParams& params,
+                                        const std::vector<std::uint8_t>& edge_kept, double price, double seconds);
 
 /// The recombination of independent parts of select_edges() alone (no annealing, no descent),
 /// from the selection `edge_kept` (uniform per group, N' in Eq. 2's band), for

@@ -129,6 +129,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"stop_reason", s.stop_reason},
       {"anneal_converged", s.anneal_converged},
       {"anneal_runs", s.anneal_runs},
+      {"anneal_priced_runs", s.anneal_priced_runs},
       {"largest_component", s.largest_component},
       {"flip_search_converged", s.flip_search_converged},
   };
