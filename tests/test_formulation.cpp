@@ -68,8 +68,10 @@ bool eq4_holds(const Prepared& p, const std::vector<std::uint8_t>& kept) {
   return true;
 }
 
-// Brute force over all segment decisions (edges of no segment decided individually).
-double oracle_optimum(const Prepared& p, std::uint64_t target, const SelectionParams& sp) {
+// Brute force: f(kept) for every combination of segment decisions (edges of no segment decided
+// individually) that keeps Eq. 8.
+template <class F>
+void for_each_selection(const Prepared& p, F&& f) {
   std::vector<std::vector<Index>> units;
   std::vector<bool> covered(p.conn.num_edges, false);
   for (const Segment& s : p.analysis.segmentation.segments) {
@@ -78,19 +80,35 @@ double oracle_optimum(const Prepared& p, std::uint64_t target, const SelectionPa
   }
   for (Index e = 0; e < p.conn.num_edges; ++e)
     if (!covered[e]) units.push_back({e});
-  EXPECT_LE(units.size(), 20u) << "oracle too large";
-  double best = INFINITY;
-  const double lo = (1 - sp.epsilon_n) * target, hi = (1 + sp.epsilon_n) * target;
+  ASSERT_LE(units.size(), 20u) << "oracle too large";
   for (std::uint32_t mask = 0; mask < (1u << units.size()); ++mask) {
     std::vector<std::uint8_t> kept(p.conn.num_edges, 1);
     for (std::size_t u = 0; u < units.size(); ++u)
       if (!(mask >> u & 1))
         for (Index e : units[u]) kept[e] = 0;
-    const double n = double(predicted_tri_equivalent(p.mesh, p.conn, kept));
-    if (n < lo || n > hi || !eq8_holds(p, kept)) continue;
-    best = std::min(best, eq9(p, kept, target, sp));
+    if (eq8_holds(p, kept)) f(kept);
   }
+}
+
+// The least Eq. 9 in Eq. 2's band over every selection (INFINITY: none in the band).
+double oracle_optimum(const Prepared& p, std::uint64_t target, const SelectionParams& sp) {
+  double best = INFINITY;
+  const double lo = (1 - sp.epsilon_n) * target, hi = (1 + sp.epsilon_n) * target;
+  for_each_selection(p, [&](const std::vector<std::uint8_t>& kept) {
+    const double n = double(predicted_tri_equivalent(p.mesh, p.conn, kept));
+    if (n >= lo && n <= hi) best = std::min(best, eq9(p, kept, target, sp));
+  });
   return best;
+}
+
+// A 3×2 grid folded 90° along x = 1, cut into segments at the fold; small enough to enumerate.
+// Bent the other way a little at one corner so importance values differ between edges.
+PolyMesh folded_grid() {
+  PolyMesh mesh = make_grid(3, 2, 3.0, 2.0);
+  for (Vec3& v : mesh.positions)
+    if (v.x() > 1.0 + 1e-9) v = Vec3(1.0, v.y(), -(v.x() - 1.0));
+  mesh.positions[0].z() += 0.2;
+  return mesh;
 }
 
 }  // namespace
@@ -143,13 +161,7 @@ TEST(Formulation, GridHalfLosesWholeChordsWithinBand) {
 }
 
 TEST(Formulation, FastAndExactMatchTheExhaustiveOracle) {
-  // A 3×2 grid folded 90° along x = 1 is cut into segments at the fold; small enough to enumerate.
-  PolyMesh mesh = make_grid(3, 2, 3.0, 2.0);
-  for (Vec3& v : mesh.positions)
-    if (v.x() > 1.0 + 1e-9) v = Vec3(1.0, v.y(), -(v.x() - 1.0));
-  // Bend the other way a little so importance values differ between edges.
-  mesh.positions[0].z() += 0.2;
-  const Prepared p = prepare(std::move(mesh));
+  const Prepared p = prepare(folded_grid());
   int feasible_targets = 0;
   for (std::uint64_t target = 3; target <= 11; ++target) {
     SelectionParams sp;
@@ -692,11 +704,7 @@ TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
   // triangle-equivalent, no band). On meshes small enough to enumerate every segment decision
   // it must end at the brute-force optimum of that value (Eq. 8 kept), for prices from "keep
   // everything" to "remove everything"; N' does not grow with the price.
-  PolyMesh folded = make_grid(3, 2, 3.0, 2.0);
-  for (Vec3& v : folded.positions)
-    if (v.x() > 1.0 + 1e-9) v = Vec3(1.0, v.y(), -(v.x() - 1.0));
-  folded.positions[0].z() += 0.2;
-  const Prepared grid = prepare(std::move(folded));
+  const Prepared grid = prepare(folded_grid());
   const Prepared cylinder = prepare(make_cylinder(6, 3));
   SelectionParams sp;
   sp.lambda_edge = 0.3;
@@ -707,29 +715,15 @@ TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
       const double n = double(predicted_tri_equivalent(p->mesh, p->conn, kept));
       return eq9(*p, kept, target, sp) - std::abs(n - double(target)) + mu * n;
     };
-    std::vector<std::vector<Index>> units;
-    std::vector<bool> covered(p->conn.num_edges, false);
-    for (const Segment& s : p->analysis.segmentation.segments) {
-      units.push_back(s.opposing_edges);
-      for (Index e : s.opposing_edges) covered[e] = true;
-    }
-    for (Index e = 0; e < p->conn.num_edges; ++e)
-      if (!covered[e]) units.push_back({e});
-    ASSERT_LE(units.size(), 20u) << "oracle too large";
     std::set<std::uint64_t> counts;
     std::uint64_t last_count = ~std::uint64_t{0};
     for (double mu : {0.05, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 6.0}) {
       double best = INFINITY;
       std::uint64_t best_count = 0;
-      for (std::uint32_t mask = 0; mask < (1u << units.size()); ++mask) {
-        std::vector<std::uint8_t> kept(p->conn.num_edges, 1);
-        for (std::size_t u = 0; u < units.size(); ++u)
-          if (!(mask >> u & 1))
-            for (Index e : units[u]) kept[e] = 0;
-        if (!eq8_holds(*p, kept)) continue;
+      for_each_selection(*p, [&](const std::vector<std::uint8_t>& kept) {
         if (const double v = priced(kept, mu); v < best - 1e-9)
           best = v, best_count = predicted_tri_equivalent(p->mesh, p->conn, kept);
-      }
+      });
       const std::vector<std::uint8_t> all(p->conn.num_edges, 1);
       const auto kept = detail::priced_anneal(p->mesh, p->conn, p->analysis, target, sp, all, mu, 600.0);
       EXPECT_NEAR(priced(kept, mu), best, 1e-9) << "price " << mu;

@@ -979,6 +979,10 @@ Index count_collapsed_clusters(const GroupConstraints& gc, const std::vector<std
   return n;
 }
 
+// The slope of the count term |N' − N| (Eq. 9) that prices start from, for d = N' − N: 0 in the
+// middle of Eq. 2's band, ±1 in its outer halves, where one direction is closed.
+double count_slope(std::int64_t d, std::int64_t band) { return 2 * std::abs(d) > band ? (d > 0 ? 1.0 : -1.0) : 0.0; }
+
 // N' (Eq. 1) of y.
 std::uint64_t selection_count(const FaceGroups& fg, const std::vector<std::uint8_t>& y) {
   std::uint64_t count = 0;
@@ -1735,7 +1739,7 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
       run.value = run.priced ? INFINITY : group_objective(g, gc, fg, run.y, target, params);
       if (r == 0) {
         const auto d = static_cast<std::int64_t>(selection_count(fg, run.y)) - static_cast<std::int64_t>(target);
-        slope = 2 * std::abs(d) > band ? (d > 0 ? 1.0 : -1.0) : 0.0;
+        slope = count_slope(d, band);
       }
       runs[std::size_t(k)].push_back(std::move(run));
     }
@@ -1882,7 +1886,7 @@ std::vector<std::uint8_t> recombine_components(const Groups& g, const GroupConst
     // The count term's slope at the incumbent: 0 between its two sides at N' = N (prices go up
     // from there: keeping a group always gains λ_edge Q), ±1 near the band's edges, where one
     // direction is closed (cg57 sits on the upper edge); the prices are offsets from it.
-    const double slope = 2 * std::abs(total - n) > band ? (total > n ? 1.0 : -1.0) : 0.0;
+    const double slope = count_slope(total - n, band);
     for (std::size_t k = 0; k < states.size() && clock.seconds() < seconds; ++k) {
       if (k < alternatives.size()) {
         states[k] = alternatives[k];
