@@ -1393,10 +1393,23 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
 // best selection seen is returned. Microseconds per move, so millions of moves fit where the
 // neighbourhood MIPs manage a few hundred; the MIPs then polish its result.
 //
-// A priced run (`price` set) anneals cost + μ N' instead: the count term of Eq. 9 replaced by a
-// price μ per triangle-equivalent, with no band and no continuation, which makes every
-// independent component a problem of its own (the Lagrangian relaxation the recombination
-// uses). Its end state lies anywhere in N' and is only an alternative for the recombination.
+// What an annealing run minimises (AnnealGoal::Kind):
+// * Band: Eq. 9 in Eq. 2's band, with the penalty continuation below.
+// * Priced: cost + μ N' instead, the count term of Eq. 9 replaced by a price μ per
+//   triangle-equivalent, with no band and no continuation, which makes every independent
+//   component a problem of its own (the Lagrangian relaxation the recombination uses). Its end
+//   state lies anywhere in N' and is only an alternative for the recombination.
+// * Reach: from a start outside the band (a greedy selection the hard constraints stopped short
+//   of it), Eq. 9 plus ρ per triangle-equivalent outside the band, moving freely; the best state
+//   is the one nearest the band, then the lowest Eq. 9 (SelectionParams::reach_time_fraction).
+struct AnnealGoal {
+  enum class Kind { Band, Priced, Reach };
+  Kind kind = Kind::Band;
+  double weight = 0.0;  // Priced: μ; Reach: ρ
+  static AnnealGoal priced(double mu) { return {Kind::Priced, mu}; }
+  static AnnealGoal reach(double rho) { return {Kind::Reach, rho}; }
+};
+
 struct AnnealStats {
   std::int64_t moves = 0, accepted = 0, compounds = 0;  // compounds: compound moves accepted
   bool schedule_done = false;  // ended by its move count, not by the time
@@ -1408,14 +1421,17 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
                                  std::vector<std::uint8_t> y, std::uint64_t target, const SelectionParams& params,
                                  double seconds, const std::vector<Index>& adj_offsets,
                                  const std::vector<Index>& adjacent, AnnealStats& stats,
-                                 std::optional<double> price = std::nullopt) {
+                                 AnnealGoal goal = {}) {
   Stopwatch clock;
   SelectionState st(g, gc, fg, std::move(y));
   const double n = double(target), band = params.epsilon_n * n;
-  const bool priced = price.has_value();
-  const double mu = price.value_or(0.0);
-  auto count_term = [&](std::int64_t c) { return priced ? mu * double(c) : std::abs(double(c) - n); };
-  auto in_band = [&](std::int64_t c) { return priced || std::abs(double(c) - n) <= band; };
+  const bool priced = goal.kind == AnnealGoal::Kind::Priced, reach = goal.kind == AnnealGoal::Kind::Reach;
+  const bool banded = goal.kind == AnnealGoal::Kind::Band;
+  auto beyond = [&](std::int64_t c) { return std::max(0.0, std::abs(double(c) - n) - band); };
+  auto count_term = [&](std::int64_t c) {
+    return priced ? goal.weight * double(c) : std::abs(double(c) - n) + (reach ? goal.weight * beyond(c) : 0.0);
+  };
+  auto in_band = [&](std::int64_t c) { return !banded || std::abs(double(c) - n) <= band; };
   std::vector<Index> movable;
   for (Index grp = 0; grp < g.count; ++grp)
     if (!g.fixed[grp]) movable.push_back(grp);
@@ -1434,19 +1450,19 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   // term weighs w0 and N' may leave Eq. 2's band by band_relax × the band; over the ramp both go
   // linearly to the true objective and the hard band, the excess beyond the band penalised by
   // band_penalty × ramp per triangle-equivalent.
-  const double w0 = priced ? 1.0 : params.anneal_count_weight, band_relax = params.anneal_band_relax;
+  const double w0 = banded ? params.anneal_count_weight : 1.0, band_relax = params.anneal_band_relax;
   const double rho_max = params.anneal_band_penalty;
   const double count_ramp_start = params.anneal_ramp_start, count_ramp_end = params.anneal_ramp_end;
   double count_weight = w0;
   double ramp = 0.0;  // 0 before the ramp, 1 after it
-  auto outside = [&](std::int64_t c) { return priced ? 0.0 : std::max(0.0, std::abs(double(c) - n) - band); };
+  auto outside = [&](std::int64_t c) { return banded ? beyond(c) : 0.0; };
   auto annealed = [&](double delta, std::int64_t c0, std::int64_t c1) {
     return delta - (1.0 - count_weight) * (count_term(c1) - count_term(c0)) +
            rho_max * ramp * (outside(c1) - outside(c0));
   };
   // Whether the annealing may go from count c0 to c1.
   auto allowed = [&](std::int64_t c0, std::int64_t c1) {
-    if (in_band(c1)) return true;
+    if (!banded || in_band(c1)) return true;
     if (ramp >= 1.0) return outside(c1) <= outside(c0);
     return std::abs(double(c1) - n) <= band * (1.0 + band_relax);
   };
@@ -1463,11 +1479,17 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       journal.clear();
     }
   };
+  // Reach: the best state is the nearest to the band, then the lowest (penalised) Eq. 9.
+  double best_beyond = reach ? beyond(st.count) : 0.0;
   auto accept = [&](double delta) {
     ++stats.accepted;
     current += delta;
-    if (current < best - 1e-9 && in_band(st.count)) {
+    const bool better = reach ? beyond(st.count) < best_beyond - 1e-9 ||
+                                    (beyond(st.count) <= best_beyond + 1e-9 && current < best - 1e-9)
+                              : current < best - 1e-9 && in_band(st.count);
+    if (better) {
       best = current;
+      best_beyond = reach ? beyond(st.count) : 0.0;
       if (journal_full) best_y = st.y;
       else
         for (Index grp : journal) best_y[grp] = st.y[grp];
@@ -1491,8 +1513,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
     }
   };
   CompoundScratch compound;
-  // (compound moves judge Eq. 9's count term themselves: not in priced runs)
-  const double compound_share = params.compound_moves && !priced ? params.anneal_compound_share : 0.0;
+  // (compound moves judge Eq. 9's count term and band themselves: only in banded runs)
+  const double compound_share = params.compound_moves && banded ? params.anneal_compound_share : 0.0;
   // The schedule runs on time or on moves, whichever ends first (small meshes: moves).
   const double max_moves = params.anneal_moves_per_group * double(movable.size());
   for (;; ++stats.moves) {
@@ -1589,13 +1611,13 @@ std::vector<std::uint8_t> anneal_chain(const Groups& g, const GroupConstraints& 
                                        std::vector<std::uint8_t> y, std::uint64_t target,
                                        const SelectionParams& params, double seconds,
                                        const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
-                                       AnnealStats& stats, std::optional<double> price = std::nullopt) {
+                                       AnnealStats& stats, AnnealGoal goal = {}) {
   Stopwatch clock;
-  const bool continuation = !price && params.anneal_plain_when_short &&
+  const bool continuation = goal.kind == AnnealGoal::Kind::Band && params.anneal_plain_when_short &&
                             (params.anneal_count_weight != 1.0 || params.anneal_band_relax != 0.0);
   std::vector<std::uint8_t> start = continuation ? y : std::vector<std::uint8_t>{};
   std::vector<std::uint8_t> best =
-      anneal(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats, price);
+      anneal(g, gc, fg, std::move(y), target, params, seconds, adj_offsets, adjacent, stats, goal);
   if (!continuation || !stats.schedule_done || clock.seconds() >= 0.5 * seconds) return best;
   SelectionParams plain = params;
   plain.anneal_count_weight = 1.0;
@@ -1733,7 +1755,7 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
       }
       Stopwatch run_clock;
       run.y = anneal_chain(g, gc, fg, y, target, p, left / double(std::max(1, planned - r)), adj_offsets, adjacent,
-                           run.stats, price);
+                           run.stats, price ? AnnealGoal::priced(*price) : AnnealGoal{});
       last = run_clock.seconds();
       run.priced = price.has_value();
       run.value = run.priced ? INFINITY : group_objective(g, gc, fg, run.y, target, params);
@@ -1770,6 +1792,51 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
     for (std::size_t i = 1; i < all.size() && alternatives->size() < params.anneal_max_alternatives; ++i)
       alternatives->push_back(std::move(all[i].y));
   return std::move(all.front().y);
+}
+
+// Reaching Eq. 2's band from a start the hard constraints stopped the greedy short of
+// (SelectionParams::reach_time_fraction; docs/formulation.md, "Targets the greedy misses"): one
+// Reach annealing run per thread (seed solve.seed + k) for `seconds`; the state nearest the band
+// wins, then the lowest Eq. 9. The greedy collapses groups cheapest first and skips any whose
+// collapse Eq. 8 forbids at that moment, so where triangle clusters interleave its early choices
+// can block more triangle-equivalents than they remove; the annealing undoes such choices.
+std::vector<std::uint8_t> reach_band(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                     const std::vector<std::uint8_t>& y, std::uint64_t target,
+                                     const SelectionParams& params, double seconds,
+                                     const std::vector<Index>& adj_offsets, const std::vector<Index>& adjacent,
+                                     int threads, AnnealStats& stats) {
+  threads = std::max(threads, 1);
+  std::vector<std::vector<std::uint8_t>> ends(static_cast<std::size_t>(threads));
+  std::vector<AnnealStats> run_stats(static_cast<std::size_t>(threads));
+  auto work = [&](int k) {
+    SelectionParams p = params;
+    p.solve.seed = params.solve.seed + static_cast<std::uint32_t>(k);
+    p.anneal_t0 = params.reach_t0;
+    ends[std::size_t(k)] = anneal(g, gc, fg, y, target, p, seconds, adj_offsets, adjacent, run_stats[std::size_t(k)],
+                                  AnnealGoal::reach(params.reach_band_penalty));
+  };
+  if (threads == 1) {
+    work(0);
+  } else {
+    std::vector<std::thread> workers;
+    for (int k = 0; k < threads; ++k) workers.emplace_back(work, k);
+    for (std::thread& w : workers) w.join();
+  }
+  const double n = double(target), band = params.epsilon_n * n;
+  auto key = [&](const std::vector<std::uint8_t>& s) {
+    const double beyond = std::max(0.0, std::abs(double(selection_count(fg, s)) - n) - band);
+    return std::pair(beyond, group_objective(g, gc, fg, s, target, params));
+  };
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < ends.size(); ++k)
+    if (key(ends[k]) < key(ends[best])) best = k;
+  stats = {};
+  for (const AnnealStats& rs : run_stats) {
+    stats.moves += rs.moves;
+    stats.accepted += rs.accepted;
+  }
+  stats.runs = threads;
+  return std::move(ends[best]);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -2057,14 +2124,33 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   result.greedy_predicted = greedy.count;
   const double lo = (1.0 - params.epsilon_n) * double(target);
   const double hi = (1.0 + params.epsilon_n) * double(target);
-  const bool reachable = double(greedy.count) >= lo && double(greedy.count) <= hi;
+  auto in_band = [&](std::uint64_t c) { return double(c) >= lo && double(c) <= hi; };
+  bool reachable = in_band(greedy.count);
   result.seconds_build = 0.0;
-
-  // Phase 1: Eq. 2 as a hard band. The greedy selection is the start when it lies in the band;
-  // otherwise the solver has to find a feasible point itself, with half the time budget.
-  // Phase 2 (only if phase 1 ends without a solution): no band, the greedy selection as start,
-  // so the result is the closest count the hard constraints allow (reported in `note`).
   const double time_limit = params.solve.time_limit_seconds;
+  const int threads = ilp::backend::resolve_threads(params.solve);
+
+  // The greedy stopped outside the band (fast formulation): an annealing that may leave the
+  // greedy's choices looks for the band first (reach_band). Its state nearest the band is the
+  // start of everything below, in the band or not.
+  std::vector<std::uint8_t> closest = greedy.y;
+  if (!reachable && time_limit > 0.0 && params.formulation == Formulation::Fast && params.reach_time_fraction > 0.0) {
+    Stopwatch reach_clock;
+    AnnealStats rs;
+    closest = reach_band(groups, gc, fg, greedy.y, target, params,
+                         params.reach_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent, threads, rs);
+    result.reach_ran = true;
+    result.reach_moves = rs.moves;
+    result.reach_predicted = selection_count(fg, closest);
+    result.seconds_reach = reach_clock.seconds();
+    reachable = in_band(result.reach_predicted);
+  }
+
+  // Phase 1: Eq. 2 as a hard band. The greedy (or reached) selection is the start when it lies
+  // in the band; otherwise the solver has to find a feasible point itself, with half of what is
+  // left of the budget. Phase 2 (only if phase 1 ends without a solution): no band, the
+  // selection nearest the band as start, so the result is the closest count found (reported in
+  // `note`).
   auto run = [&](ModelBuilder& builder, double seconds) -> std::vector<double> {
     std::string error;
     auto solver = ilp::make_solver(params.solver, &error);
@@ -2206,7 +2292,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
 
   // The greedy selection, polished by single flips and adjacent swaps, is the start of every
   // solve (skipped for a greedy-only run and when the greedy misses the band).
-  std::vector<std::uint8_t> start_y = greedy.y;
+  std::vector<std::uint8_t> start_y = closest;
   std::vector<std::vector<std::uint8_t>> alternatives;  // other annealing runs, for the recombination
   if (reachable && time_limit > 0.0) {
     // Fast formulation: simulated annealing from the greedy selection until anneal_time_fraction
@@ -2216,7 +2302,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       AnnealStats as;
       start_y = anneal_runs(groups, gc, fg, std::move(start_y), target, params,
                             params.anneal_time_fraction * time_limit - clock.seconds(), adj_offsets, adjacent,
-                            ilp::backend::resolve_threads(params.solve), as, &alternatives);
+                            threads, as, &alternatives);
       result.anneal_moves = as.moves;
       result.anneal_accepted = as.accepted;
       result.anneal_compounds = as.compounds;
@@ -2282,6 +2368,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   if (reachable) banded.model.set_initial_solution(banded_start);
 
   std::vector<double> solution;
+  bool proven_out_of_reach = false;  // phase 1 proved the band infeasible
   const ModelBuilder* used = &banded;
   const auto free_groups = static_cast<Index>(std::count(groups.fixed.begin(), groups.fixed.end(), 0));
   const bool neighbourhoods =
@@ -2311,30 +2398,34 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
     // whole-model MIP never found a point in the band in its half of the budget (cg57 at 0.4,
     // rounds after pins: 0 of 18), but each call cost 1–3 s beyond its limit (loading 300k rows,
     // the child process).
-    solution = run(banded, 0.5 * time_limit);
+    solution = run(banded, 0.5 * std::max(0.1 * time_limit, time_limit - clock.seconds()));
     result.band_enforced = !solution.empty();
+    proven_out_of_reach = solution.empty() && result.solve.status == ilp::SolveStatus::Infeasible;
   }
   std::optional<ModelBuilder> open;
-  if (solution.empty() && time_limit > 0.0 && neighbourhoods && large) {
-    // On a large model the greedy selection stays: it went as close to N as the hard
-    // constraints let it, and Eq. 9 without the band would trade count for λ_geo (a search of
-    // the open model raised N' by ~3 % on cg57's later rounds, away from the target). The banded
-    // model evaluates it like the open one would (same objective; only p's or q's bound is off).
-    solution = banded.complete(greedy.y, target);
-    result.greedy_objective = banded.model.evaluate(solution);
+  if (solution.empty() && time_limit > 0.0 && ((neighbourhoods && large) || result.reach_ran)) {
+    // The selection nearest the band stays (the greedy's on a large model, or reach_band's):
+    // Eq. 9 without the band would trade count for λ_geo (a search of the open model raised N'
+    // by ~3 % on cg57's later rounds, away from the target; on a cube with N' ∈ {12, 4, 0} for
+    // N = 3 it kept all 12). The banded model evaluates it like the open one would (same
+    // objective; only p's or q's bound is off).
+    result.greedy_objective = banded.model.evaluate(banded.complete(greedy.y, target));
+    solution = banded.complete(closest, target);
   } else if (solution.empty()) {
     Stopwatch rebuild_clock;
     open.emplace(mesh, conn, analysis, groups, gc, fg, importance, params);
     open->build(target, false);
-    const std::vector<double> start = open->complete(greedy.y, target);
+    result.greedy_objective = open->model.evaluate(open->complete(greedy.y, target));
+    const std::vector<double> start = open->complete(closest, target);
     open->model.set_initial_solution(start);
-    result.greedy_objective = open->model.evaluate(start);
     result.seconds_build += rebuild_clock.seconds();
-    solution = time_limit > 0.0 ? run(*open, 0.5 * time_limit) : start;
+    solution = time_limit > 0.0 ? run(*open, std::max(0.1 * time_limit, time_limit - clock.seconds())) : start;
     if (solution.empty()) solution = start;
     used = &*open;
   }
-  if (time_limit <= 0.0 || (!result.band_enforced && neighbourhoods && large)) {
+  if (!result.band_enforced && result.reach_ran) {
+    result.stop_reason = "band not reached";
+  } else if (time_limit <= 0.0 || (!result.band_enforced && neighbourhoods && large)) {
     result.stop_reason = "greedy";
   } else if (result.strategy == "neighbourhoods") {
     result.stop_reason = result.neighbourhoods_converged ? "converged" : "time";
@@ -2354,10 +2445,27 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   // The open search of phase 2 may still land in the band: then the target was not out of reach.
   if (!result.band_enforced && std::abs(double(result.predicted) - double(target)) <= params.epsilon_n * double(target))
     result.band_enforced = true;
-  if (!result.band_enforced && result.note.empty())
-    result.note = "target " + std::to_string(target) + " is out of reach of the hard constraints: " +
-                  "the closest selection found has " + std::to_string(result.predicted) +
-                  " triangle-equivalents";
+  // Out of reach only where the solver proved it; otherwise what was searched, and the nearest.
+  if (!result.band_enforced && result.note.empty()) {
+    char text[320];
+    if (proven_out_of_reach)
+      std::snprintf(text, sizeof text,
+                    "target %llu is out of reach of the hard constraints (the solver proved that no selection "
+                    "lies within %g %% of it): the closest selection found has %llu triangle-equivalents",
+                    static_cast<unsigned long long>(target), 100.0 * params.epsilon_n,
+                    static_cast<unsigned long long>(result.predicted));
+    else
+      std::snprintf(text, sizeof text,
+                    "no selection within %g %% of the target %llu was found under the hard constraints (%s): the "
+                    "closest selection found has %llu triangle-equivalents",
+                    100.0 * params.epsilon_n, static_cast<unsigned long long>(target),
+                    result.reach_ran && result.solver_ran ? "searched by annealing and the MIP solver"
+                    : result.reach_ran                    ? "searched by annealing"
+                    : result.solver_ran                   ? "searched by the MIP solver"
+                                                          : "greedy only, no search",
+                    static_cast<unsigned long long>(result.predicted));
+    result.note = text;
+  }
   return result;
 }
 
@@ -2437,7 +2545,23 @@ std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity
   group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
   AnnealStats as;
   const std::vector<std::uint8_t> y =
-      anneal_chain(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as, price);
+      anneal_chain(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as,
+                   AnnealGoal::priced(price));
+  std::vector<std::uint8_t> kept(conn.num_edges);
+  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
+  return kept;
+}
+
+std::vector<std::uint8_t> reach_band(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                     std::uint64_t target, const SelectionParams& params,
+                                     const std::vector<std::uint8_t>& edge_kept, double seconds) {
+  Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  std::vector<Index> adj_offsets, adjacent;
+  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  AnnealStats as;
+  const std::vector<std::uint8_t> y =
+      quadlod::reach_band(p.groups, p.gc, p.fg, p.y, target, params, seconds, adj_offsets, adjacent,
+                          ilp::backend::resolve_threads(params.solve), as);
   std::vector<std::uint8_t> kept(conn.num_edges);
   for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
   return kept;

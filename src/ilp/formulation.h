@@ -141,6 +141,18 @@ struct SelectionParams {
   /// counts (docs/formulation.md, "Speed"). A long budget is not affected: the annealing then ends
   /// by its move count (c172p at 180 s: after 41 s).
   double anneal_time_fraction = 0.9;
+  /// Where the greedy selection misses Eq. 2's band (the hard constraints stopped it short),
+  /// the fast formulation first anneals on Eq. 9 plus reach_band_penalty per triangle-equivalent
+  /// outside the band, one run per thread, for up to this fraction of the time limit; the state
+  /// nearest the band (then the lowest Eq. 9) is the start of everything after it. 0: the greedy
+  /// selection is kept (docs/formulation.md, "Targets the greedy misses").
+  /// The penalty ρ and the starting temperature of that annealing (it falls to anneal_t1): on
+  /// tpsdemo_door_reactor at 0.4 (greedy 4 200 for N = 3 768, band ≤ 3 881) ρ = 8 with t0 = 128
+  /// reaches the band (3 881) on every seed tried; ρ = 1, 2, 4, 16, 32 with Eq. 9's t0 = 8 end
+  /// at 3 894–4 200, and ρ = 32 needs t0 ≥ 128 too (docs/formulation.md).
+  double reach_time_fraction = 0.25;
+  double reach_band_penalty = 8.0;
+  double reach_t0 = 128.0;
   /// After annealing, the descent runs until this fraction of the time limit has passed.
   double descent_end_fraction = 0.97;
   /// Recombination of independent parts (docs/formulation.md, "Speed"; fast formulation, after
@@ -239,7 +251,8 @@ struct SelectionResult {
   Index collapsed_clusters = 0;         ///< Eq. 6 clusters with every edge collapsed
   bool band_enforced = false;           ///< Eq. 2 was a hard constraint (else unreachable)
   /// Empty, or why the selection is not what was asked for ("target at or above the input
-  /// size: nothing to do", "target below what the hard constraints allow: closest is ...").
+  /// size: nothing to do", "out of reach of the hard constraints" where the solver proved it,
+  /// "no selection within 3 % ... was found" otherwise, each with the closest count).
   std::string note;
 
   bool solver_ran = false;
@@ -259,6 +272,10 @@ struct SelectionResult {
   double seconds_anneal = 0.0;
   int anneal_runs = 0;                  ///< annealing runs, over all threads
   int anneal_priced_runs = 0;           ///< of which priced (SelectionParams::anneal_prices)
+  bool reach_ran = false;               ///< the greedy missed the band and reach_band searched for it
+  std::int64_t reach_moves = 0;         ///< annealing moves of that search
+  std::uint64_t reach_predicted = 0;    ///< N' of its state nearest the band
+  double seconds_reach = 0.0;
   Index components = 0;                 ///< independent parts (components of the free groups)
   Index largest_component = 0;          ///< free groups in the largest of them
   Index recombination_rounds = 0, recombination_improved = 0, recombination_moved = 0;
@@ -266,7 +283,8 @@ struct SelectionResult {
   double recombination_gain = 0.0;      ///< Eq. 9 lowered by the recombination (before the second descent)
   SelectionModelStats model;
   /// Why the selection stopped (docs/formulation.md, "Speed"): "nothing to do", "greedy" (no
-  /// time limit, or a target out of reach on a model too large for a whole MIP), "optimal" (whole-model MIP proven optimal), "converged" (the neighbourhood
+  /// time limit), "band not reached" (neither the greedy, nor reach_band, nor a whole-model
+  /// MIP where the model is small found a selection in Eq. 2's band: the nearest is kept), "optimal" (whole-model MIP proven optimal), "converged" (the neighbourhood
   /// search finished two sweeps without an improvement), "stalled" (whole-model MIP without an
   /// improvement for SelectionParams::whole_stall_seconds), "time" (the time limit).
   std::string stop_reason;
@@ -328,6 +346,14 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
 std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                         std::uint64_t target, const SelectionParams& params,
                                         const std::vector<std::uint8_t>& edge_kept, double price, double seconds);
+
+/// The search for Eq. 2's band that follows a greedy selection outside it
+/// (SelectionParams::reach_time_fraction), from the selection `edge_kept` (uniform per group,
+/// Eq. 8 kept), on params.solve.threads threads: returns the edge bits of the state nearest the
+/// band, then lowest in Eq. 9.
+std::vector<std::uint8_t> reach_band(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                     std::uint64_t target, const SelectionParams& params,
+                                     const std::vector<std::uint8_t>& edge_kept, double seconds);
 
 /// The recombination of independent parts of select_edges() alone (no annealing, no descent),
 /// from the selection `edge_kept` (uniform per group, N' in Eq. 2's band), for

@@ -130,6 +130,10 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"anneal_converged", s.anneal_converged},
       {"anneal_runs", s.anneal_runs},
       {"anneal_priced_runs", s.anneal_priced_runs},
+      {"reach_ran", s.reach_ran},
+      {"reach_moves", s.reach_moves},
+      {"reach_predicted", s.reach_predicted},
+      {"seconds_reach", s.seconds_reach},
       {"largest_component", s.largest_component},
       {"flip_search_converged", s.flip_search_converged},
   };
@@ -329,6 +333,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"selection_seconds",
          {{"prepare", selection.seconds_prepare},
           {"greedy", selection.seconds_greedy},
+          {"reach", selection.seconds_reach},
           {"anneal", selection.seconds_anneal},
           {"descent", selection.seconds_flip_search},
           {"build", selection.seconds_build},
