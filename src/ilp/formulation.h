@@ -35,12 +35,13 @@ struct SelectionParams {
   /// ϵ_N of Eq. 2: N' must lie within (1 ± epsilon_n)·N. The paper's value.
   double epsilon_n = 0.03;
   /// λ_geo of Eq. 9: cost of collapsing every edge of one geometric cluster (Eq. 6), in
-  /// triangle-equivalents. Default chosen by measurement (docs/parameters.md).
-  double lambda_geo = 4.0;
+  /// triangle-equivalents. Default chosen by measurement (docs/parameters.md, "Edge selection:
+  /// λ_geo and λ_edge"; 4 until session 9).
+  double lambda_geo = 2.0;
   /// λ_edge of Eq. 9: weight of the edge-importance term Σ Q(e)·x_e, where Q(e) is the edge's
   /// quadric collapse cost divided by the mean over all edges (so 1 = an average edge).
-  /// Default chosen by measurement (docs/parameters.md).
-  double lambda_edge = 0.05;
+  /// Default chosen by measurement (docs/parameters.md; 0.05 until session 9).
+  double lambda_edge = 0.1;
   /// λ_tri (beyond the paper): cost of each quad whose two opposite edges are decided apart —
   /// one collapsed, one kept — which turns the quad into a triangle. Such pairs exist only
   /// across segment breakpoints (§3.2.2) and without Eq. 4. In triangle-equivalents, like the
