@@ -2290,8 +2290,8 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   result.model.size = banded.model.size();
   result.seconds_build = build_clock.seconds();
 
-  // The greedy selection, polished by single flips and adjacent swaps, is the start of every
-  // solve (skipped for a greedy-only run and when the greedy misses the band).
+  // The greedy selection (or reach_band's), annealed and polished by the descent, is the start
+  // of every solve (skipped for a greedy-only run and when neither lies in the band).
   std::vector<std::uint8_t> start_y = closest;
   std::vector<std::vector<std::uint8_t>> alternatives;  // other annealing runs, for the recombination
   if (reachable && time_limit > 0.0) {

@@ -149,8 +149,9 @@ struct SelectionParams {
   /// selection is kept (docs/formulation.md, "Targets the greedy misses").
   /// The penalty ρ and the starting temperature of that annealing (it falls to anneal_t1): on
   /// tpsdemo_door_reactor at 0.4 (greedy 4 200 for N = 3 768, band ≤ 3 881) ρ = 8 with t0 = 128
-  /// reaches the band (3 881) on every seed tried; ρ = 1, 2, 4, 16, 32 with Eq. 9's t0 = 8 end
-  /// at 3 894–4 200, and ρ = 32 needs t0 ≥ 128 too (docs/formulation.md).
+  /// reaches the band (3 881) on every seed tried; ρ = 1 – 32 with Eq. 9's t0 = 8 end at
+  /// 3 894 – 4 200, and ρ = 32 reaches it with t0 = 128 (with t0 = 32 only at 5 000 moves per
+  /// group) (docs/formulation.md, "Targets the greedy misses").
   double reach_time_fraction = 0.25;
   double reach_band_penalty = 8.0;
   double reach_t0 = 128.0;
