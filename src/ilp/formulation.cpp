@@ -2482,6 +2482,15 @@ struct Prepared {
   GroupConstraints gc;
   FaceGroups fg;
   std::vector<std::uint8_t> y;
+  std::vector<Index> adj_offsets, adjacent;  // group_adjacency, after with_adjacency()
+
+  void with_adjacency() { group_adjacency(groups, fg, adj_offsets, adjacent); }
+  // Per-group bits back to per-edge bits.
+  std::vector<std::uint8_t> edge_bits(const Connectivity& conn, const std::vector<std::uint8_t>& bits) const {
+    std::vector<std::uint8_t> kept(conn.num_edges);
+    for (Index e = 0; e < conn.num_edges; ++e) kept[e] = bits[groups.edge_group[e]];
+    return kept;
+  }
 };
 Prepared prepare(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                  const SelectionParams& params, const std::vector<std::uint8_t>& edge_kept) {
@@ -2527,48 +2536,34 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
                                        std::uint64_t target, const SelectionParams& params,
                                        const std::vector<std::uint8_t>& edge_kept, double seconds) {
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
-  std::vector<Index> adj_offsets, adjacent;
-  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  p.with_adjacency();
   AnnealStats as;
   if (params.anneal_time_fraction > 0.0)
-    p.y = anneal_runs(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent,
+    p.y = anneal_runs(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, p.adj_offsets, p.adjacent,
                       ilp::backend::resolve_threads(params.solve), as, nullptr);
   FlipSearchStats stats;
-  const std::vector<std::uint8_t> y =
-      flip_search(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, stats);
-  std::vector<std::uint8_t> kept(conn.num_edges);
-  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
-  return kept;
+  return p.edge_bits(conn, flip_search(p.groups, p.gc, p.fg, p.y, target, params, seconds, p.adj_offsets,
+                                       p.adjacent, stats));
 }
 
 std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                         std::uint64_t target, const SelectionParams& params,
                                         const std::vector<std::uint8_t>& edge_kept, double price, double seconds) {
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
-  std::vector<Index> adj_offsets, adjacent;
-  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  p.with_adjacency();
   AnnealStats as;
-  const std::vector<std::uint8_t> y =
-      anneal_chain(p.groups, p.gc, p.fg, std::move(p.y), target, params, seconds, adj_offsets, adjacent, as,
-                   AnnealGoal::priced(price));
-  std::vector<std::uint8_t> kept(conn.num_edges);
-  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
-  return kept;
+  return p.edge_bits(conn, anneal_chain(p.groups, p.gc, p.fg, p.y, target, params, seconds, p.adj_offsets,
+                                        p.adjacent, as, AnnealGoal::priced(price)));
 }
 
 std::vector<std::uint8_t> reach_band(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                      std::uint64_t target, const SelectionParams& params,
                                      const std::vector<std::uint8_t>& edge_kept, double seconds) {
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
-  std::vector<Index> adj_offsets, adjacent;
-  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  p.with_adjacency();
   AnnealStats as;
-  const std::vector<std::uint8_t> y =
-      quadlod::reach_band(p.groups, p.gc, p.fg, p.y, target, params, seconds, adj_offsets, adjacent,
-                          ilp::backend::resolve_threads(params.solve), as);
-  std::vector<std::uint8_t> kept(conn.num_edges);
-  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
-  return kept;
+  return p.edge_bits(conn, quadlod::reach_band(p.groups, p.gc, p.fg, p.y, target, params, seconds, p.adj_offsets,
+                                               p.adjacent, ilp::backend::resolve_threads(params.solve), as));
 }
 
 std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
@@ -2576,17 +2571,14 @@ std::vector<std::uint8_t> recombine(const PolyMesh& mesh, const Connectivity& co
                                     const std::vector<std::uint8_t>& edge_kept, Index* components,
                                     const std::vector<std::vector<std::uint8_t>>& alternatives) {
   Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
-  std::vector<Index> adj_offsets, adjacent;
-  group_adjacency(p.groups, p.fg, adj_offsets, adjacent);
+  p.with_adjacency();
   std::vector<std::vector<std::uint8_t>> states;
   for (const std::vector<std::uint8_t>& kept : alternatives) states.push_back(prepare(mesh, conn, analysis, params, kept).y);
   RecombineStats stats;
-  const std::vector<std::uint8_t> y = recombine_components(p.groups, p.gc, p.fg, std::move(p.y), target, params,
-                                                           INFINITY, adj_offsets, adjacent, stats, states);
+  const std::vector<std::uint8_t> y = recombine_components(p.groups, p.gc, p.fg, p.y, target, params, INFINITY,
+                                                           p.adj_offsets, p.adjacent, stats, states);
   if (components) *components = stats.components;
-  std::vector<std::uint8_t> kept(conn.num_edges);
-  for (Index e = 0; e < conn.num_edges; ++e) kept[e] = y[p.groups.edge_group[e]];
-  return kept;
+  return p.edge_bits(conn, y);
 }
 
 }  // namespace detail
