@@ -721,7 +721,8 @@ TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
   // A priced run anneals cost + μ N' (Eq. 9 with the count term replaced by a price per
   // triangle-equivalent, no band). On meshes small enough to enumerate every segment decision
   // it must end at the brute-force optimum of that value (Eq. 8 kept), for prices from "keep
-  // everything" to "remove everything"; N' does not grow with the price.
+  // everything" to "remove everything"; N' does not grow with the price. The same holds for a
+  // priced run by component (SelectionParams::priced_by_component).
   const Prepared grid = prepare(folded_grid());
   const Prepared cylinder = prepare(make_cylinder(6, 3));
   SelectionParams sp;
@@ -748,6 +749,13 @@ TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
       EXPECT_NEAR(priced(kept, mu), best, 1e-9) << "price " << mu;
       EXPECT_TRUE(eq4_holds(*p, kept));
       EXPECT_TRUE(eq8_holds(*p, kept));
+      // The same price by component (one round of two runs of 5 000 moves per group).
+      SelectionParams by_component = sp;
+      by_component.priced_moves_per_group = by_component.priced_moves_per_group_max = 5000;
+      const auto per_part = detail::priced_component_anneal(p->mesh, p->conn, p->analysis, by_component, all, mu, 600.0);
+      EXPECT_NEAR(priced(per_part, mu), best, 1e-9) << "price " << mu << ", by component";
+      EXPECT_TRUE(eq4_holds(*p, per_part));
+      EXPECT_TRUE(eq8_holds(*p, per_part));
       const std::uint64_t n = predicted_tri_equivalent(p->mesh, p->conn, kept);
       EXPECT_LE(n, last_count) << "price " << mu;
       last_count = n;
@@ -785,6 +793,9 @@ TEST(Formulation, AnnealingRunsSplitTheTimeOnlyWhenNoComponentDominates) {
     EXPECT_EQ(dominated, p == &one);
     EXPECT_EQ(r.anneal_runs, dominated ? 1 : 3);
     EXPECT_EQ(r.anneal_priced_runs, dominated ? 0 : 1);  // the second of three
+    // The priced run anneals the three tori one by one, each at least twice (the first round).
+    if (dominated) EXPECT_EQ(r.priced_component_runs, 0);
+    else EXPECT_GE(r.priced_component_runs, 6);
   }
 }
 

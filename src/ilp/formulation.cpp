@@ -1412,6 +1412,7 @@ struct AnnealGoal {
 
 struct AnnealStats {
   std::int64_t moves = 0, accepted = 0, compounds = 0;  // compounds: compound moves accepted
+  std::int64_t component_runs = 0;  // priced runs by component: annealings of one component
   bool schedule_done = false;  // ended by its move count, not by the time
   int runs = 0;                // annealing runs (anneal_runs)
   int priced_runs = 0;         // of which priced
@@ -1686,6 +1687,177 @@ FreeComponents free_components(const Groups& g, const GroupConstraints& gc, cons
   return fc;
 }
 
+// Scratch of anneal_component, kept across calls.
+struct ComponentScratch {
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t round = 0;
+  std::vector<Index> queue;
+  std::vector<std::pair<Index, std::int64_t>> flipped;
+  std::vector<std::uint8_t> best;
+};
+
+// One priced annealing (cost + μ N', no band) of the groups of one free component, in a state
+// shared with the other components: no term of Eq. 9 but the count couples components, and the
+// price makes the count separable, so the component's moves see only its own groups. The moves
+// are those of anneal() (flip, swap with a neighbour, chain along split partners); the schedule
+// runs t0 → t1 over `moves` moves, or ends early at the clock's `deadline`. The state ends at the
+// best selection of the component the run met; returns its value minus the start's.
+double anneal_component(SelectionState& st, const Groups& g, const GroupConstraints& gc,
+                        const Index* movable, std::size_t m, double mu, std::int64_t moves,
+                        const SelectionParams& params, const std::vector<Index>& adj_offsets,
+                        const std::vector<Index>& adjacent, std::mt19937_64& rng, ComponentScratch& sc,
+                        const Stopwatch& clock, double deadline, std::int64_t& moves_done) {
+  if (m == 0) return 0.0;
+  if (sc.stamp.size() != g.count) sc.stamp.assign(g.count, 0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  sc.best.resize(m);
+  for (std::size_t i = 0; i < m; ++i) sc.best[i] = st.y[movable[i]];
+  double current = 0.0, best = 0.0;
+  const double t0 = params.anneal_t0, t1 = params.anneal_t1;
+  double temperature = t0;
+  auto& flipped = sc.flipped;
+  auto apply = [&](Index grp, double& delta) {
+    if (st.y[grp] && !st.may_collapse(grp)) return false;
+    const std::int64_t dc = st.delta_count(grp);
+    delta += st.delta_rest(grp, params) + mu * double(dc);
+    st.flip(grp, dc);
+    flipped.emplace_back(grp, dc);
+    return true;
+  };
+  auto undo = [&] {
+    while (!flipped.empty()) {
+      st.flip(flipped.back().first, -flipped.back().second);
+      flipped.pop_back();
+    }
+  };
+  auto take = [&](double delta) {
+    current += delta;
+    if (current < best - 1e-9) {
+      best = current;
+      for (std::size_t i = 0; i < m; ++i) sc.best[i] = st.y[movable[i]];
+    }
+  };
+  auto rejected = [&](double delta) { return delta > 0.0 && unit(rng) >= std::exp(-delta / temperature); };
+  std::int64_t k = 0;
+  for (; k < moves; ++k) {
+    if ((k & 255) == 0) {
+      if ((k & 16383) == 0 && k > 0 && clock.seconds() >= deadline) break;
+      temperature = t0 * std::pow(t1 / t0, double(k) / double(moves));
+    }
+    const Index a = movable[rng() % m];
+    const std::uint64_t kind = rng() % 3;
+    flipped.clear();
+    double delta = 0.0;
+    if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
+      // judged before it is made, as in anneal()
+      const std::int64_t dc = st.delta_count(a);
+      delta = mu * double(dc) + st.delta_rest(a, params);
+      if (rejected(delta) || (st.y[a] && !st.may_collapse(a))) continue;
+      st.flip(a, dc);
+      take(delta);
+      continue;
+    }
+    if (kind == 1) {
+      const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
+      if (g.fixed[b] || st.y[b] == st.y[a]) continue;
+      const Index keep = st.y[a] ? b : a, drop = st.y[a] ? a : b;  // keep first: never breaks Eq. 8
+      apply(keep, delta);
+      if (!apply(drop, delta)) {
+        undo();
+        continue;
+      }
+    } else {
+      const std::uint8_t v = st.y[a];
+      const std::size_t length = 2 + rng() % 15;
+      sc.queue.assign(1, a);
+      sc.stamp[a] = ++sc.round;
+      for (std::size_t head = 0; head < sc.queue.size() && flipped.size() < length; ++head) {
+        const Index x = sc.queue[head];
+        if (st.y[x] != v || !apply(x, delta)) continue;
+        for (Index b : gc.group_split[x])
+          if (!g.fixed[b] && sc.stamp[b] != sc.round && st.y[b] == v) {
+            sc.stamp[b] = sc.round;
+            sc.queue.push_back(b);
+          }
+      }
+      if (flipped.empty()) continue;
+    }
+    if (rejected(delta)) {
+      undo();
+      continue;
+    }
+    take(delta);
+  }
+  moves_done += k;
+  // Back to the best state: flip() does not check Eq. 8, and the end state (the best) kept it.
+  for (std::size_t i = 0; i < m; ++i)
+    if (st.y[movable[i]] != sc.best[i]) st.flip(movable[i], st.delta_count(movable[i]));
+  return best;
+}
+
+// A priced run by component (SelectionParams::priced_by_component): from `y`, in rounds of
+// growing effort. Round r gives every component still open two annealings of
+// priced_moves_per_group × factor^r moves per group, each from the component's state in `y`; a
+// component whose two annealings end at the same value, equal to its best so far, is closed.
+// Rounds go on up to priced_moves_per_group_max while `seconds` last. Every component ends at
+// the best state it met (its state in `y` if that is lower). Why: the annealing of the whole mesh
+// spends the same moves on every group, but most components of a many-part mesh reach their
+// best state at the price within a few hundred moves per group, and a few reach states 8 – 18
+// lower only now and then at 1 600 (c172p at 0.4, μ = 0.3, eight seeds; docs/formulation.md).
+std::vector<std::uint8_t> anneal_priced_components(const Groups& g, const GroupConstraints& gc, const FaceGroups& fg,
+                                                   const FreeComponents& fc, std::vector<std::uint8_t> y,
+                                                   double mu, const SelectionParams& params, double seconds,
+                                                   const std::vector<Index>& adj_offsets,
+                                                   const std::vector<Index>& adjacent, AnnealStats& stats) {
+  Stopwatch clock;
+  SelectionState st(g, gc, fg, std::move(y));
+  const std::vector<std::uint8_t> start = st.y;
+  std::vector<std::uint8_t> best_y = st.y;
+  std::vector<double> best(fc.count, 0.0);  // relative to the start
+  std::vector<Index> open(fc.count);
+  std::iota(open.begin(), open.end(), Index{0});
+  std::mt19937_64 rng(params.solve.seed);
+  ComponentScratch sc;
+  const double factor = std::max(params.priced_moves_factor, 1.0 + 1e-9);
+  // At most the moves of a whole-mesh schedule (anneal_moves_per_group per free group): where
+  // schedules end by their move count (small meshes), more runs in the same time do better.
+  const double budget = params.anneal_moves_per_group * double(fc.offsets.back());
+  const std::int64_t moves_before = stats.moves;
+  auto spent = [&] { return clock.seconds() >= seconds || double(stats.moves - moves_before) >= budget; };
+  for (double per_group = params.priced_moves_per_group;
+       !open.empty() && per_group <= params.priced_moves_per_group_max * (1.0 + 1e-9); per_group *= factor) {
+    std::size_t kept_open = 0;
+    for (std::size_t i = 0; i < open.size(); ++i) {
+      const Index c = open[i];
+      const Index* movable = &fc.groups[fc.offsets[c]];
+      const std::size_t m = fc.offsets[c + 1] - fc.offsets[c];
+      const auto moves = static_cast<std::int64_t>(std::ceil(per_group * double(m)));
+      double value[2] = {INFINITY, INFINITY};
+      for (double& v : value) {
+        if (spent()) break;
+        for (std::size_t j = 0; j < m; ++j)  // from the start: restarts, not continuations
+          if (st.y[movable[j]] != start[movable[j]]) st.flip(movable[j], st.delta_count(movable[j]));
+        v = anneal_component(st, g, gc, movable, m, mu, moves, params, adj_offsets, adjacent, rng, sc, clock,
+                             seconds, stats.moves);
+        ++stats.component_runs;
+        if (v < best[c] - 1e-9) {
+          best[c] = v;
+          for (std::size_t j = 0; j < m; ++j) best_y[movable[j]] = st.y[movable[j]];
+        }
+      }
+      if (spent()) {
+        kept_open = 0;
+        open.clear();
+        break;
+      }
+      const bool settled = std::abs(value[0] - value[1]) <= 1e-9 && std::abs(value[0] - best[c]) <= 1e-9;
+      if (!settled) open[kept_open++] = c;
+    }
+    open.resize(kept_open);
+  }
+  return best_y;
+}
+
 // Annealing runs on `threads` threads (issue 4; docs/formulation.md, "Speed"). Each thread runs
 // annealing chains one after the other from the same start: params.anneal_runs of them, each an
 // equal share of what is left of its time, and more while at least half the last run's time is
@@ -1714,11 +1886,13 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
   // 142.7 / 167.8, opensubdiv_bishop_cage 97.0 / 103.1, blender_suzanne 641.8 / 646.6;
   // assimp_suzanne_subdiv is the exception, -10 263.7 / -10 288.2).
   int planned = std::max(params.anneal_runs, 1);
+  FreeComponents components;
   if (planned > 1) {
-    const FreeComponents fc = free_components(g, gc, fg);
+    components = free_components(g, gc, fg);
     Index largest = 0;
-    for (Index c = 0; c < fc.count; ++c) largest = std::max(largest, fc.offsets[c + 1] - fc.offsets[c]);
-    if (double(largest) > params.anneal_runs_max_share * double(fc.offsets.back())) planned = 1;
+    for (Index c = 0; c < components.count; ++c)
+      largest = std::max(largest, components.offsets[c + 1] - components.offsets[c]);
+    if (double(largest) > params.anneal_runs_max_share * double(components.offsets.back())) planned = 1;
   }
   Stopwatch clock;
   struct Run {
@@ -1733,7 +1907,8 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
   // priced one, at a price of the count term's slope at the thread's first run (0 inside the
   // band's middle, ±1 near its edges, as in the recombination) plus the next offset of
   // anneal_prices (mirrored below the band), so that each component also offers states at the
-  // exchange rates of triangle-equivalents against Eq. 9's other terms.
+  // exchange rates of triangle-equivalents against Eq. 9's other terms. With priced_by_component
+  // it anneals the components one by one from the thread's first run (anneal_priced_components).
   const bool priced_runs = planned > 1 && !params.anneal_prices.empty();
   const auto band = static_cast<std::int64_t>(std::floor(params.epsilon_n * double(target)));
   auto work = [&](int k) {
@@ -1754,8 +1929,13 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
         price = slope + (slope < 0.0 ? -offset : offset);
       }
       Stopwatch run_clock;
-      run.y = anneal_chain(g, gc, fg, y, target, p, left / double(std::max(1, planned - r)), adj_offsets, adjacent,
-                           run.stats, price ? AnnealGoal::priced(*price) : AnnealGoal{});
+      const double share = left / double(std::max(1, planned - r));
+      if (price && params.priced_by_component)  // from the thread's first (plain) run
+        run.y = anneal_priced_components(g, gc, fg, components, runs[std::size_t(k)].front().y, *price, p, share,
+                                         adj_offsets, adjacent, run.stats);
+      else
+        run.y = anneal_chain(g, gc, fg, y, target, p, share, adj_offsets, adjacent, run.stats,
+                             price ? AnnealGoal::priced(*price) : AnnealGoal{});
       last = run_clock.seconds();
       run.priced = price.has_value();
       run.value = run.priced ? INFINITY : group_objective(g, gc, fg, run.y, target, params);
@@ -1785,6 +1965,7 @@ std::vector<std::uint8_t> anneal_runs(const Groups& g, const GroupConstraints& g
     stats.moves += run.stats.moves;
     stats.accepted += run.stats.accepted;
     stats.compounds += run.stats.compounds;
+    stats.component_runs += run.stats.component_runs;
   }
   stats.runs = static_cast<int>(all.size());
   stats.schedule_done = all.front().stats.schedule_done;
@@ -2309,6 +2490,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
       result.anneal_converged = as.schedule_done;
       result.anneal_runs = as.runs;
       result.anneal_priced_runs = as.priced_runs;
+      result.priced_component_runs = as.component_runs;
       result.seconds_anneal = anneal_clock.seconds();
     }
     // The recombination (after annealing only) takes its share from the end of the descent's.
@@ -2554,6 +2736,18 @@ std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity
   AnnealStats as;
   return p.edge_bits(conn, anneal_chain(p.groups, p.gc, p.fg, p.y, target, params, seconds, p.adj_offsets,
                                         p.adjacent, as, AnnealGoal::priced(price)));
+}
+
+std::vector<std::uint8_t> priced_component_anneal(const PolyMesh& mesh, const Connectivity& conn,
+                                                  const AnalysisResult& analysis, const SelectionParams& params,
+                                                  const std::vector<std::uint8_t>& edge_kept, double price,
+                                                  double seconds) {
+  Prepared p = prepare(mesh, conn, analysis, params, edge_kept);
+  p.with_adjacency();
+  AnnealStats as;
+  const FreeComponents fc = free_components(p.groups, p.gc, p.fg);
+  return p.edge_bits(conn, anneal_priced_components(p.groups, p.gc, p.fg, fc, p.y, price, params, seconds,
+                                                    p.adj_offsets, p.adjacent, as));
 }
 
 std::vector<std::uint8_t> reach_band(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,

@@ -206,8 +206,23 @@ struct SelectionParams {
   /// second, fourth, … run anneals cost + μ N' (Eq. 9 with the count term replaced by a price μ
   /// per triangle-equivalent) for μ = the count term's slope at the thread's first run (0, or ±1
   /// near the band's edges) plus the next of these offsets (mirrored below the band), and is
-  /// only an alternative for the recombination. Empty = no priced runs.
-  std::vector<double> anneal_prices = {0.25, 0.4, 0.15, 0.3};
+  /// only an alternative for the recombination. Empty = no priced runs. Since λ_geo 2 and
+  /// λ_edge 0.1, c172p's components at 0.4 add up to N between μ = 0.25 and 0.3; 0.25, 0.3
+  /// gave lower Eq. 9 at 5 s than 0.25, 0.4 and than 0.2, 0.3 (docs/formulation.md, "Priced runs
+  /// by component").
+  std::vector<double> anneal_prices = {0.25, 0.3, 0.2, 0.35};
+  /// A priced run anneals each independent component on its own (docs/formulation.md, "Priced
+  /// runs by component"): every component gets two runs of priced_moves_per_group moves per
+  /// group, then the components whose two runs ended apart get two runs of priced_moves_factor
+  /// times as many, and so on (up to priced_moves_per_group_max), while the run's time lasts and
+  /// it has made fewer moves than a whole-mesh schedule (anneal_moves_per_group per free group);
+  /// each component keeps its best state. The run starts from the thread's first (plain) run.
+  /// false = one annealing of the whole mesh per priced run, from the start. Start effort 200
+  /// against 100 measured on c172p at 0.4, 5 s; the factor 4 and the cap 6 400 are not tuned.
+  bool priced_by_component = true;
+  double priced_moves_per_group = 200.0;
+  double priced_moves_factor = 4.0;
+  double priced_moves_per_group_max = 6400.0;
   /// anneal_runs applies only when no independent component holds more than this share of the
   /// free groups; otherwise one run per thread (plus the extra ones).
   double anneal_runs_max_share = 0.5;
@@ -274,6 +289,7 @@ struct SelectionResult {
   double seconds_anneal = 0.0;
   int anneal_runs = 0;                  ///< annealing runs, over all threads
   int anneal_priced_runs = 0;           ///< of which priced (SelectionParams::anneal_prices)
+  std::int64_t priced_component_runs = 0;  ///< component annealings of the priced runs (priced_by_component)
   bool reach_ran = false;               ///< the greedy missed the band and reach_band searched for it
   std::int64_t reach_moves = 0;         ///< annealing moves of that search
   std::uint64_t reach_predicted = 0;    ///< N' of its state nearest the band
@@ -348,6 +364,15 @@ std::vector<std::uint8_t> local_search(const PolyMesh& mesh, const Connectivity&
 std::vector<std::uint8_t> priced_anneal(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                         std::uint64_t target, const SelectionParams& params,
                                         const std::vector<std::uint8_t>& edge_kept, double price, double seconds);
+
+/// One priced run by component (SelectionParams::priced_by_component) from the selection
+/// `edge_kept` (uniform per group, Eq. 8 kept): every independent component annealed on its own
+/// on cost + price × N', in rounds of growing effort, for up to `seconds`; returns the edge bits
+/// of every component's best state.
+std::vector<std::uint8_t> priced_component_anneal(const PolyMesh& mesh, const Connectivity& conn,
+                                                  const AnalysisResult& analysis, const SelectionParams& params,
+                                                  const std::vector<std::uint8_t>& edge_kept, double price,
+                                                  double seconds);
 
 /// The search for Eq. 2's band that follows a greedy selection outside it
 /// (SelectionParams::reach_time_fraction), from the selection `edge_kept` (uniform per group,

@@ -130,6 +130,7 @@ nlohmann::json solve_json(const SelectionResult& s) {
       {"anneal_converged", s.anneal_converged},
       {"anneal_runs", s.anneal_runs},
       {"anneal_priced_runs", s.anneal_priced_runs},
+      {"priced_component_runs", s.priced_component_runs},
       {"reach_ran", s.reach_ran},
       {"reach_moves", s.reach_moves},
       {"reach_predicted", s.reach_predicted},
