@@ -766,6 +766,28 @@ TEST(Formulation, PricedAnnealingFindsTheOptimumAtItsPrice) {
   }
 }
 
+TEST(Formulation, PricedRunsByComponentStopAtTheMovesOfAWholeMeshSchedule) {
+  // A priced run by component makes no more moves than a whole-mesh schedule
+  // (anneal_moves_per_group per free group). With one move per group, the first component
+  // annealing (200 moves per group of its component) uses the whole budget, so every priced run
+  // anneals exactly one component; with the cap out of reach each anneals all three tori twice.
+  const Prepared three =
+      prepare(two_parts(two_parts(mixed_torus(), mixed_torus(), Vec3(3.0, 0.0, 0.0)), mixed_torus(), Vec3(0.0, 3.0, 0.0)));
+  const auto target = static_cast<std::uint64_t>(std::llround(0.6 * double(tri_equivalent_count(three.mesh))));
+  for (const double per_group : {1.0, 1e12}) {
+    SelectionParams sp;
+    sp.lambda_edge = 0.3;
+    sp.anneal_moves_per_group = per_group;
+    sp.anneal_max_runs = 4;
+    sp.solve.time_limit_seconds = 0.6;
+    sp.solve.threads = 1;
+    const SelectionResult r = select_edges(three.mesh, three.conn, three.analysis, target, sp);
+    ASSERT_GT(r.anneal_priced_runs, 0) << per_group;
+    if (per_group == 1.0) EXPECT_EQ(r.priced_component_runs, r.anneal_priced_runs);
+    else EXPECT_GE(r.priced_component_runs, 6 * r.anneal_priced_runs);
+  }
+}
+
 TEST(Formulation, AnnealingRunsSplitTheTimeOnlyWhenNoComponentDominates) {
   // anneal_runs runs per thread when no independent component holds more than
   // anneal_runs_max_share of the free groups (three copies of the mixed torus side by side), one

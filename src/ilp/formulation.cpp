@@ -1384,6 +1384,70 @@ std::vector<std::uint8_t> flip_search(const Groups& g, const GroupConstraints& g
   return std::move(st.y);
 }
 
+// The two-group and chain moves of the annealing (anneal() and anneal_component()). Their flips
+// are journaled in `flipped`, so that a rejected move is undone; `rest` collects their change of
+// Eq. 9 without the count term (the caller prices the count from st.count).
+struct MoveScratch {
+  std::vector<std::pair<Index, std::int64_t>> flipped;
+  std::vector<Index> queue;
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t round = 0;
+};
+
+// Flips grp unless collapsing it would break Eq. 8 (then nothing is done: false).
+bool flip_journaled(SelectionState& st, Index grp, const SelectionParams& params, double& rest, MoveScratch& ms) {
+  if (st.y[grp] && !st.may_collapse(grp)) return false;
+  const std::int64_t dc = st.delta_count(grp);
+  rest += st.delta_rest(grp, params);
+  st.flip(grp, dc);
+  ms.flipped.emplace_back(grp, dc);
+  return true;
+}
+
+void undo_journaled(SelectionState& st, MoveScratch& ms) {
+  while (!ms.flipped.empty()) {
+    st.flip(ms.flipped.back().first, -ms.flipped.back().second);
+    ms.flipped.pop_back();
+  }
+}
+
+// Swaps a with a random group of the other value that shares a face with it (a must have one).
+// The kept one first: keeping never breaks Eq. 8. false = nothing flipped.
+bool swap_move(SelectionState& st, const Groups& g, Index a, const std::vector<Index>& adj_offsets,
+               const std::vector<Index>& adjacent, std::mt19937_64& rng, const SelectionParams& params,
+               double& rest, MoveScratch& ms) {
+  const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
+  if (g.fixed[b] || st.y[b] == st.y[a]) return false;
+  const Index keep = st.y[a] ? b : a, drop = st.y[a] ? a : b;
+  flip_journaled(st, keep, params, rest, ms);
+  if (!flip_journaled(st, drop, params, rest, ms)) {
+    undo_journaled(st, ms);
+    return false;
+  }
+  return true;
+}
+
+// Flips 2 – 16 groups of a's value, breadth-first along split partners from a (λ_tri pairs).
+// false = nothing flipped.
+bool chain_move(SelectionState& st, const Groups& g, const GroupConstraints& gc, Index a, std::mt19937_64& rng,
+                const SelectionParams& params, double& rest, MoveScratch& ms) {
+  if (ms.stamp.size() != g.count) ms.stamp.assign(g.count, 0);
+  const std::uint8_t v = st.y[a];
+  const std::size_t length = 2 + rng() % 15;
+  ms.queue.assign(1, a);
+  ms.stamp[a] = ++ms.round;
+  for (std::size_t head = 0; head < ms.queue.size() && ms.flipped.size() < length; ++head) {
+    const Index x = ms.queue[head];
+    if (st.y[x] != v || !flip_journaled(st, x, params, rest, ms)) continue;
+    for (Index b : gc.group_split[x])
+      if (!g.fixed[b] && ms.stamp[b] != ms.round && st.y[b] == v) {
+        ms.stamp[b] = ms.round;
+        ms.queue.push_back(b);
+      }
+  }
+  return !ms.flipped.empty();
+}
+
 // Simulated annealing over the local-search moves (beyond the paper; docs/formulation.md,
 // "Speed"): random single flips, swaps with an adjacent group of the other value, and chains of
 // random length along λ_tri split partners (see chain_moves), each evaluated exactly through the
@@ -1441,10 +1505,8 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
   std::mt19937_64 rng(params.solve.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   double current = 0.0, best = 0.0;  // relative to the start
-  std::vector<std::pair<Index, std::int64_t>> flipped;
-  std::vector<Index> queue;
-  std::vector<std::uint32_t> stamp(g.count, 0);
-  std::uint32_t round = 0;
+  MoveScratch moves;
+  auto& flipped = moves.flipped;
   const double t0 = params.anneal_t0, t1 = params.anneal_t1;
   double temperature = t0;
   // Penalty continuation (SelectionParams::anneal_count_weight): until the ramp starts the count
@@ -1498,21 +1560,6 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       journal_full = false;
     }
   };
-  // Flips grp if allowed; false (nothing done) when a collapse would break Eq. 8.
-  auto apply = [&](Index grp, double& rest) {
-    if (st.y[grp] && !st.may_collapse(grp)) return false;
-    const std::int64_t dc = st.delta_count(grp);
-    rest += st.delta_rest(grp, params);
-    st.flip(grp, dc);
-    flipped.emplace_back(grp, dc);
-    return true;
-  };
-  auto undo = [&] {
-    while (!flipped.empty()) {
-      st.flip(flipped.back().first, -flipped.back().second);
-      flipped.pop_back();
-    }
-  };
   CompoundScratch compound;
   // (compound moves judge Eq. 9's count term and band themselves: only in banded runs)
   const double compound_share = params.compound_moves && banded ? params.anneal_compound_share : 0.0;
@@ -1541,7 +1588,7 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       if (!(delta < INFINITY)) continue;  // nothing in the band; the state is unchanged
       const double da = annealed(delta, c0, st.count);
       if (da > 0.0 && unit(rng) >= std::exp(-da / temperature)) {
-        undo();
+        undo_journaled(st, moves);
         continue;
       }
       ++stats.compounds;
@@ -1564,35 +1611,15 @@ std::vector<std::uint8_t> anneal(const Groups& g, const GroupConstraints& gc, co
       record(a);
       accept(delta);
       continue;
-    } else if (kind == 1) {  // swap with an adjacent group of the other value
-      const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
-      if (g.fixed[b] || st.y[b] == st.y[a]) continue;
-      const Index keep = st.y[a] ? b : a, drop = st.y[a] ? a : b;  // keep first: never breaks Eq. 8
-      apply(keep, rest);
-      if (!apply(drop, rest)) {
-        undo();
-        continue;
-      }
-    } else {  // chain along split partners of the same value
-      const std::uint8_t v = st.y[a];
-      const std::size_t length = 2 + rng() % 15;
-      queue.assign(1, a);
-      stamp[a] = ++round;
-      for (std::size_t head = 0; head < queue.size() && flipped.size() < length; ++head) {
-        const Index x = queue[head];
-        if (st.y[x] != v || !apply(x, rest)) continue;
-        for (Index b : gc.group_split[x])
-          if (!g.fixed[b] && stamp[b] != round && st.y[b] == v) {
-            stamp[b] = round;
-            queue.push_back(b);
-          }
-      }
-      if (flipped.empty()) continue;
+    } else if (kind == 1) {
+      if (!swap_move(st, g, a, adj_offsets, adjacent, rng, params, rest, moves)) continue;
+    } else if (!chain_move(st, g, gc, a, rng, params, rest, moves)) {
+      continue;
     }
     const double delta = count_term(st.count) - count_term(c0) + rest;
     const double da = annealed(delta, c0, st.count);
     if (!allowed(c0, st.count) || (da > 0.0 && unit(rng) >= std::exp(-da / temperature))) {
-      undo();
+      undo_journaled(st, moves);
       continue;
     }
     for (const auto& fl : flipped) record(fl.first);
@@ -1689,10 +1716,7 @@ FreeComponents free_components(const Groups& g, const GroupConstraints& gc, cons
 
 // Scratch of anneal_component, kept across calls.
 struct ComponentScratch {
-  std::vector<std::uint32_t> stamp;
-  std::uint32_t round = 0;
-  std::vector<Index> queue;
-  std::vector<std::pair<Index, std::int64_t>> flipped;
+  MoveScratch moves;
   std::vector<std::uint8_t> best;
 };
 
@@ -1708,28 +1732,12 @@ double anneal_component(SelectionState& st, const Groups& g, const GroupConstrai
                         const std::vector<Index>& adjacent, std::mt19937_64& rng, ComponentScratch& sc,
                         const Stopwatch& clock, double deadline, std::int64_t& moves_done) {
   if (m == 0) return 0.0;
-  if (sc.stamp.size() != g.count) sc.stamp.assign(g.count, 0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   sc.best.resize(m);
   for (std::size_t i = 0; i < m; ++i) sc.best[i] = st.y[movable[i]];
   double current = 0.0, best = 0.0;
   const double t0 = params.anneal_t0, t1 = params.anneal_t1;
   double temperature = t0;
-  auto& flipped = sc.flipped;
-  auto apply = [&](Index grp, double& delta) {
-    if (st.y[grp] && !st.may_collapse(grp)) return false;
-    const std::int64_t dc = st.delta_count(grp);
-    delta += st.delta_rest(grp, params) + mu * double(dc);
-    st.flip(grp, dc);
-    flipped.emplace_back(grp, dc);
-    return true;
-  };
-  auto undo = [&] {
-    while (!flipped.empty()) {
-      st.flip(flipped.back().first, -flipped.back().second);
-      flipped.pop_back();
-    }
-  };
   auto take = [&](double delta) {
     current += delta;
     if (current < best - 1e-9) {
@@ -1746,44 +1754,24 @@ double anneal_component(SelectionState& st, const Groups& g, const GroupConstrai
     }
     const Index a = movable[rng() % m];
     const std::uint64_t kind = rng() % 3;
-    flipped.clear();
-    double delta = 0.0;
+    sc.moves.flipped.clear();
+    const std::int64_t c0 = st.count;
     if (kind == 0 || (kind == 1 && adj_offsets[a] == adj_offsets[a + 1])) {
       // judged before it is made, as in anneal()
       const std::int64_t dc = st.delta_count(a);
-      delta = mu * double(dc) + st.delta_rest(a, params);
+      const double delta = mu * double(dc) + st.delta_rest(a, params);
       if (rejected(delta) || (st.y[a] && !st.may_collapse(a))) continue;
       st.flip(a, dc);
       take(delta);
       continue;
     }
-    if (kind == 1) {
-      const Index b = adjacent[adj_offsets[a] + rng() % (adj_offsets[a + 1] - adj_offsets[a])];
-      if (g.fixed[b] || st.y[b] == st.y[a]) continue;
-      const Index keep = st.y[a] ? b : a, drop = st.y[a] ? a : b;  // keep first: never breaks Eq. 8
-      apply(keep, delta);
-      if (!apply(drop, delta)) {
-        undo();
-        continue;
-      }
-    } else {
-      const std::uint8_t v = st.y[a];
-      const std::size_t length = 2 + rng() % 15;
-      sc.queue.assign(1, a);
-      sc.stamp[a] = ++sc.round;
-      for (std::size_t head = 0; head < sc.queue.size() && flipped.size() < length; ++head) {
-        const Index x = sc.queue[head];
-        if (st.y[x] != v || !apply(x, delta)) continue;
-        for (Index b : gc.group_split[x])
-          if (!g.fixed[b] && sc.stamp[b] != sc.round && st.y[b] == v) {
-            sc.stamp[b] = sc.round;
-            sc.queue.push_back(b);
-          }
-      }
-      if (flipped.empty()) continue;
-    }
+    double rest = 0.0;
+    if (kind == 1 ? !swap_move(st, g, a, adj_offsets, adjacent, rng, params, rest, sc.moves)
+                  : !chain_move(st, g, gc, a, rng, params, rest, sc.moves))
+      continue;
+    const double delta = rest + mu * double(st.count - c0);
     if (rejected(delta)) {
-      undo();
+      undo_journaled(st, sc.moves);
       continue;
     }
     take(delta);
