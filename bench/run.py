@@ -5,7 +5,8 @@ k-gon = k - 2, as quadlod counts it) and every result is measured by `quadlod ev
 samples, seed and thread count. Outputs (all written atomically: temporary file, then rename):
 
   OUT/results.csv     one row per (mesh, ratio, method); failures are rows with status=failed
-  OUT/tables.md       Table 1 (methods per ratio), Table 2 (ablations), losses, validity, failures
+  OUT/tables.md       Table 1 (methods per ratio), Table 2 (ablations), the bar (quadlod against
+                      Single), losses, validity, failures
   OUT/fig9_hausdorff.png, OUT/fig9_chamfer.png   QPR against distance (log x), like paper Fig. 9
   OUT/settings.json   the measurement settings and tool versions the rows were measured with
   OUT/runs/MESH/RATIO/METHOD.*   per-run logs, quadlod reports, peer reports, eval JSON
@@ -42,10 +43,13 @@ REPO = os.path.dirname(HERE)
 # name -> (kind, extra quadlod flags or peer mode, label in tables)
 METHODS = {
     "quadlod": ("quadlod", [], "quadlod"),
+    "quadlod-greedy": ("quadlod", ["--time-limit", "0"], "quadlod greedy"),
     "quadlod-no-consistency": ("quadlod", ["--no-consistency"], "w/o Consist."),
     "quadlod-no-segmentation": ("quadlod", ["--no-segmentation"], "w/o Segmt."),
     "quadlod-no-geometry": ("quadlod", ["--no-geometry"], "w/o Geo."),
     "quadlod-no-dual": ("quadlod", ["--no-dual"], "w/o Dual"),
+    "single": ("single", ["default"], "Single"),
+    "single-rel": ("single", ["rel"], "Single rel-eps"),
     "meshopt": ("meshopt", [], "meshoptimizer"),
     "meshlab": ("meshlab", [], "MeshLab QEC"),
     "blender-collapse": ("blender", ["collapse"], "Blender collapse"),
@@ -53,15 +57,25 @@ METHODS = {
 }
 ABLATIONS = ["quadlod-no-consistency", "quadlod-no-segmentation", "quadlod-no-geometry",
              "quadlod-no-dual"]
-PEERS = ["meshopt", "meshlab", "blender-collapse", "blender-unsubdiv"]
-TABLE1_METHODS = ["quadlod"] + PEERS
+PEERS = ["single", "single-rel", "meshopt", "meshlab", "blender-collapse", "blender-unsubdiv"]
+TABLE1_METHODS = ["quadlod", "quadlod-greedy"] + PEERS
+
+# Single (Knodt 2025, the author's simple_qem): an external binary, never linked or vendored
+# (../shared/peers/single/README.md). `single-rel` sets --abs-eps to this fraction of the input's
+# bounding-box max extent (the scale-invariant variant that README describes).
+SINGLE_DEFAULT = os.path.normpath(os.path.join(REPO, "..", "shared", "peers", "single", "decimate"))
+SINGLE_REL_EPS = 5e-4
+
+# The quality bar (--bar-method against --bar-peer, per ratio; see bar_section).
+BAR_QFR_MARGIN = 0.10
+BAR_CHAMFER_SHARE = 0.60
 TABLE2_METHODS = ["quadlod"] + ABLATIONS
 
 COLUMNS = [
     "mesh", "ratio", "method", "status", "error",
     "target", "achieved", "achieved_rel_error",
     "faces_in", "tri_equivalent_in", "faces", "quads", "tris", "ngons",
-    "qpr", "qpr_rule", "pccd", "pccd_defined", "chamfer", "hausdorff",
+    "qpr", "qpr_rule", "quad_fraction", "pccd", "pccd_defined", "chamfer", "hausdorff",
     "nonmanifold_edges_new", "nonmanifold_edges", "nonmanifold_vertices",
     "degenerate_faces", "degenerate_faces_in", "duplicate_faces", "duplicate_faces_in",
     "zero_length_edges", "zero_length_edges_in",
@@ -289,6 +303,39 @@ def write_fan_ply(src, dst):
     return ntri
 
 
+def bbox_max_extent(verts):
+    """Longest side of the axis-aligned bounding box of a vertex list (0 for none)."""
+    if not verts:
+        return 0.0
+    return max(max(v[k] for v in verts) - min(v[k] for v in verts) for k in range(3))
+
+
+def write_stripped_obj(src, dst):
+    """Positions and polygons only (v and 1-based f records; no vt/vn/usemtl/mtllib/o/g/s): the
+    Single peer's input, so it gets the same clean geometry as every peer. Every vertex is kept
+    (indices unchanged). Returns the bounding-box max extent of the vertices."""
+    verts, faces = read_obj_polygons(src)
+    buf = io.StringIO()
+    buf.write("# quadlod bench: positions and polygons of %s\n" % os.path.basename(src))
+    for v in verts:
+        buf.write("v %r %r %r\n" % v)
+    for p in faces:
+        buf.write("f " + " ".join(str(i + 1) for i in p) + "\n")
+    write_atomic(dst, buf.getvalue())
+    return bbox_max_extent(verts)
+
+
+def obj_vertex_extent(path):
+    """bbox_max_extent of the `v` records of an OBJ (a cached stripped copy)."""
+    verts = []
+    with open(path, "r", errors="replace") as f:
+        for line in f:
+            if line.startswith("v "):
+                t = line.split()
+                verts.append((float(t[1]), float(t[2]), float(t[3])))
+    return bbox_max_extent(verts)
+
+
 # ---------------------------------------------------------------------------------------------
 # The benchmark
 # ---------------------------------------------------------------------------------------------
@@ -336,6 +383,9 @@ class Bench:
                 self.meshlabserver, self.xvfb_run = ml, xv
                 available["meshlab"] = True
                 self.peer_versions["meshlab"] = dpkg_version("meshlab")
+        single_methods = [m for m in methods if METHODS[m][0] == "single"]
+        if single_methods:
+            available.update(self._find_single(single_methods))
         blender_methods = [m for m in methods if METHODS[m][0] == "blender"]
         if blender_methods:
             b = shutil.which(a.blender)
@@ -373,6 +423,25 @@ class Bench:
                 os.unlink(tmp)
             time.sleep(5)  # being relinked right now: try again
         sys.exit("bench/run: %s does not run (`%s --help` fails); is it being rebuilt?" % (binary, binary))
+
+    def _find_single(self, single_methods):
+        """--single PATH, else $QUADLOD_SINGLE, else ../shared/peers/single/decimate."""
+        a = self.args
+        if a.single:
+            path, where = a.single, "--single"
+        elif os.environ.get("QUADLOD_SINGLE"):
+            path, where = os.environ["QUADLOD_SINGLE"], "QUADLOD_SINGLE"
+        else:
+            path, where = SINGLE_DEFAULT, "default path"
+        found = path if os.path.isfile(path) else (shutil.which(path) if os.sep not in path else None)
+        if not found or not os.access(found, os.X_OK):
+            log("peer single (%s): skipped (%s not found (%s); set QUADLOD_SINGLE or pass "
+                "--single PATH, see ../shared/peers/single/README.md)" % (
+                    ", ".join(single_methods), path, where))
+            return {}
+        self.single = os.path.abspath(found)
+        self.peer_versions["single"] = "simple_qem sha256:%s" % sha256(self.single)[:12]
+        return {m: True for m in single_methods}
 
     def _find_meshopt(self):
         a = self.args
@@ -466,6 +535,26 @@ class Bench:
                     raise RunFailure("fan triangulation: %s" % first_error_line(str(e)))
         return dst
 
+    def stripped_obj(self, mesh_path):
+        """OUT/work/MESH.vf.obj (positions + polygons, cached like the fan PLY) and the input's
+        bounding-box max extent."""
+        name = os.path.splitext(os.path.basename(mesh_path))[0]
+        dst = os.path.join(self.out, "work", name + ".vf.obj")
+        with self.mesh_lock:
+            lock = self.mesh_locks.setdefault(dst, threading.Lock())
+        with lock:
+            if dst in self.mesh_info:
+                return dst, self.mesh_info[dst]
+            try:
+                if os.path.exists(dst) and os.path.getmtime(dst) >= os.path.getmtime(mesh_path):
+                    extent = obj_vertex_extent(dst)
+                else:
+                    extent = write_stripped_obj(mesh_path, dst)
+            except (OSError, ValueError, IndexError) as e:
+                raise RunFailure("stripped OBJ: %s" % first_error_line(str(e)))
+            self.mesh_info[dst] = extent
+        return dst, extent
+
     # -- one run --------------------------------------------------------------------------------
 
     def run_one(self, mesh_path, ratio, method):
@@ -495,6 +584,8 @@ class Bench:
                 output = self._run_meshlab(mesh_path, target, base, row)
             elif kind == "blender":
                 output = self._run_blender(mesh_path, target, extra[0], base, row)
+            elif kind == "single":
+                output = self._run_single(mesh_path, target, extra[0], base, row)
             self._eval(mesh_path, output, base, row)
             row["status"] = "ok"
             row["error"] = ""
@@ -519,7 +610,7 @@ class Bench:
         report = base + ".report.json"
         cmd = [self.quadlod, "-q", "simplify", mesh_path, "-o", output, "--ratio", ratio_key(ratio),
                "--report", report, "--threads", str(a.quadlod_threads)] + flags
-        if a.time_limit is not None:
+        if a.time_limit is not None and "--time-limit" not in flags:  # quadlod-greedy has its own
             cmd += ["--time-limit", "%g" % a.time_limit]
         rc, out, err, seconds = self.runner.run(cmd, a.timeout, base + ".log")
         row["seconds_total"] = seconds
@@ -596,6 +687,36 @@ class Bench:
             row["parameter"] = "TargetFaceNum=%d; saved %s vn %s fn" % (target, m.group(1), m.group(2))
         return output
 
+    def _run_single(self, mesh_path, target, mode, base, row):
+        obj, extent = self.stripped_obj(mesh_path)
+        output = base + ".obj"
+        tmp = os.path.join(os.path.dirname(base), "." + os.path.basename(base) + ".tmp.obj")
+        cmd = [self.single, "-i", obj, "-o", tmp, "--tri-number", str(target)]
+        peer = {"input": obj, "tri_number": target, "bbox_max_extent": extent}
+        if mode == "rel":
+            eps = SINGLE_REL_EPS * extent
+            cmd += ["--abs-eps", "%.6g" % eps]
+            peer["abs_eps"] = float("%.6g" % eps)
+            row["parameter"] = "abs_eps=%.6g (%g x bbox max extent %.6g)" % (eps, SINGLE_REL_EPS, extent)
+        else:
+            row["parameter"] = "abs_eps=default"
+        try:
+            rc, out, err, seconds = self.runner.run(cmd, self.args.timeout, base + ".log")
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        row["seconds_total"] = seconds
+        if rc != 0 or not os.path.exists(tmp):
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise RunFailure("single: %s: %s" % (exit_text(rc), first_error_line(
+                (err or "") + "\n" + (out or ""), "no output written")), seconds=seconds)
+        os.replace(tmp, output)
+        peer["seconds_process"] = seconds
+        write_atomic(base + ".peer.json", json.dumps(peer, indent=1) + "\n")
+        return output
+
     def _run_blender(self, mesh_path, target, mode, base, row):
         output = base + ".obj"
         script = os.path.join(HERE, "peers", "blender_decimate.py")
@@ -642,6 +763,7 @@ class Bench:
                    achieved_rel_error=(achieved - target) / target if achieved is not None and target else None,
                    faces=ev.get("faces_out"), quads=ev.get("quads_out"), tris=ev.get("tris_out"),
                    ngons=ev.get("ngons_out"), qpr=ev.get("qpr"), qpr_rule=ev.get("qpr_rule"),
+                   quad_fraction=ev.get("quad_fraction_out"),
                    pccd=ev.get("pccd"), pccd_defined=ev.get("pccd_defined"),
                    chamfer=ev.get("chamfer"), hausdorff=ev.get("hausdorff"),
                    nonmanifold_edges_new=val.get("new_nonmanifold_edges"),
@@ -762,6 +884,31 @@ def ratio_label(r):
     return "%d%% Δ" % round(float(r) * 100)
 
 
+def qfr(r):
+    """Output quad fraction, quads / faces: eval's `quad_fraction_out` (CSV `quad_fraction`), or
+    from the counts for rows written before that column existed."""
+    v = num(r.get("quad_fraction"))
+    if v is not None:
+        return v
+    q, f = num(r.get("quads")), num(r.get("faces"))
+    return q / f if q is not None and f else None
+
+
+def invalid_reasons(r):
+    """Why an ok output is invalid: new non-manifold edges, more degenerate or duplicate faces
+    than the input, or faces flipped against the input surface (eval's `flipped_faces`; input
+    faces kept unchanged count in `flipped_faces_kept` and are not flips). [] = valid."""
+    probs = []
+    if (num(r.get("nonmanifold_edges_new")) or 0) > 0:
+        probs.append("%d new non-manifold edges" % num(r["nonmanifold_edges_new"]))
+    for k in ("degenerate_faces", "duplicate_faces"):
+        if (num(r.get(k)) or 0) > (num(r.get(k + "_in")) or 0):
+            probs.append("%s %d (input %d)" % (k.replace("_", " "), num(r[k]), num(r.get(k + "_in")) or 0))
+    if (num(r.get("flipped_faces")) or 0) > 0:
+        probs.append("%d flipped faces" % num(r["flipped_faces"]))
+    return probs
+
+
 def block_table(rows, ratio, methods, labels):
     """Rows for one ratio block: averages over the meshes where every method that has at least
     one success at this ratio succeeded (so each column averages the same meshes)."""
@@ -794,6 +941,7 @@ def block_table(rows, ratio, methods, labels):
         return "–" if v is None else "%.2f%%" % (100 * v)
 
     metrics = [
+        ("Avg. quad fraction, quads/faces [↑]", lambda rs: fmt_fixed(mean(qfr(r) for r in rs))),
         ("Avg. QPR [↑]", avg("qpr", fmt_fixed)),
         ("Avg. PCCD [↓]", pccd),
         ("Avg. Chamfer [↓]", avg("chamfer", fmt_sci)),
@@ -805,10 +953,14 @@ def block_table(rows, ratio, methods, labels):
         ("Avg. time, process [s]", avg("seconds_total", lambda v: fmt_fixed(v, 2))),
         ("Avg. time, reduction only [s]", avg("seconds_core", lambda v: fmt_fixed(v, 3))),
         ("Meshes ok / run", None),
+        ("Invalid outputs / ok", "invalid"),
     ]
     lines = []
     for i, (name, f) in enumerate(metrics):
-        if f is None:
+        if f == "invalid":  # over every ok output of the method at this ratio
+            cells = ["%d / %d" % (sum(1 for r in by_m[m].values() if r["status"] == "ok" and invalid_reasons(r)),
+                                  sum(1 for r in by_m[m].values() if r["status"] == "ok")) for m in methods]
+        elif f is None:
             cells = ["%d / %d" % (sum(1 for r in by_m[m].values() if r["status"] == "ok"),
                                   len(by_m[m])) for m in methods]
         else:
@@ -817,18 +969,20 @@ def block_table(rows, ratio, methods, labels):
     return lines, common, excluded
 
 
-def make_tables(rows, settings):
+def make_tables(rows, settings, bar=None):
+    """tables.md; `bar`: the bar section's lines (bar_section), placed after Table 2."""
     rows = list(rows)
     ratios = sorted({r["ratio"] for r in rows}, key=lambda x: -float(x))
     out = []
     out.append("# quadlod benchmark\n")
     out.append("Generated %s by `bench/run` from `results.csv` (%d rows). Every output is measured "
                "by `quadlod eval --samples %s --seed %s`; targets are triangle-equivalents "
-               "(quad = 2, k-gon = k − 2), the same for every method. quadlod `--time-limit %s`. "
+               "(quad = 2, k-gon = k − 2), the same for every method. quadlod `--time-limit %s`%s. "
                "Peers: %s.\n" % (
                    datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), len(rows),
                    settings.get("samples"), settings.get("seed"),
                    settings.get("time_limit") if settings.get("time_limit") is not None else "default",
+                   " (quadlod greedy: `--time-limit 0`)" if any(r["method"] == "quadlod-greedy" for r in rows) else "",
                    ", ".join("%s %s" % kv for kv in sorted(settings.get("peer_versions", {}).items()))
                    or "none"))
     out.append("Averages in each ratio block run over the meshes where every method with any "
@@ -872,6 +1026,9 @@ def make_tables(rows, settings):
             out.append("")
             if excluded:
                 out.append("* averages over %d meshes; excluded: %s\n" % (len(common), ", ".join(excluded)))
+
+    if bar:
+        out.extend(bar)
 
     # Losses
     out.extend(losses_section(rows))
@@ -963,24 +1120,128 @@ def losses_section(rows):
     return out
 
 
+def bar_section(rows, method="quadlod", peer="single"):
+    """The quality bar of `method` against `peer`, per ratio, over the meshes where both succeeded:
+    mean quad fraction >= peer's + BAR_QFR_MARGIN; mean Hausdorff, Chamfer, PCCD and flow
+    deviation <= the peer's; Chamfer <= the peer's on >= BAR_CHAMFER_SHARE of the meshes; no
+    invalid output (invalid_reasons). Returns (Markdown lines, {ratio: passed or None})."""
+    lm, lp = METHODS[method][2], METHODS[peer][2]
+    out = ["## Bar: %s against %s\n" % (lm, lp)]
+    mine = [r for r in rows if r["method"] == method]
+    theirs = [r for r in rows if r["method"] == peer]
+    if not mine or not theirs:
+        out.append("Not checked: no rows for %s.\n" % " and ".join(
+            m for m, rs in ((method, mine), (peer, theirs)) if not rs))
+        return out, {}
+    out.append("Per ratio, over the meshes where both %s and %s succeeded: mean quad fraction "
+               "(quads/faces) ≥ %s's + %.2f; mean Hausdorff, Chamfer, PCCD and flow deviation ≤ "
+               "%s's (PCCD over the meshes where both define it, flow deviation where both "
+               "measure it); %s's Chamfer ≤ %s's on ≥ %d %% of the meshes; every %s output valid "
+               "(no new non-manifold edge, no more degenerate or duplicate faces than the input, "
+               "no flipped face).\n" % (lm, lp, lp, BAR_QFR_MARGIN, lp, lm, lp,
+                                         round(100 * BAR_CHAMFER_SHARE), lm))
+    ratios = sorted({r["ratio"] for r in mine} & {r["ratio"] for r in theirs}, key=lambda x: -float(x))
+    verdicts = {}
+    losses = []
+    for ratio in ratios:
+        a = {r["mesh"]: r for r in mine if r["ratio"] == ratio}
+        b = {r["mesh"]: r for r in theirs if r["ratio"] == ratio}
+        both = sorted(x for x in a if x in b and a[x]["status"] == "ok" and b[x]["status"] == "ok")
+        a_failed = sorted(x for x in a if x in b and a[x]["status"] != "ok" and b[x]["status"] == "ok")
+        title = "### %s: %d meshes where both succeeded" % (ratio_label(ratio).replace(" Δ", ""), len(both))
+        out.append(title + (" (of %d with rows for both)\n" % len(set(a) & set(b))))
+        if a_failed:
+            out.append("%s failed where %s succeeded (not counted): %s\n" % (lm, lp, ", ".join(a_failed)))
+        if not both:
+            out.append("Not checked: no mesh where both succeeded.\n")
+            verdicts[ratio] = None
+            continue
+        crit = []
+
+        def less_equal(name, key, fmt, defined=None):
+            pairs = [(num(a[x].get(key)), num(b[x].get(key))) for x in both
+                     if defined is None or defined(a[x], b[x])]
+            pairs = [(u, v) for u, v in pairs if u is not None and v is not None]
+            if not pairs:
+                crit.append((name, "–", "–", None))
+                return
+            mu, mv = mean(u for u, _ in pairs), mean(v for _, v in pairs)
+            sub = "" if len(pairs) == len(both) else " (%d of %d meshes)" % (len(pairs), len(both))
+            crit.append((name + sub, fmt(mu), fmt(mv), mu <= mv))
+
+        qa, qb = mean(qfr(a[x]) for x in both), mean(qfr(b[x]) for x in both)
+        crit.append(("mean quad fraction ≥ %s + %.2f" % (lp, BAR_QFR_MARGIN), fmt_fixed(qa),
+                     "%s (+%.2f = %s)" % (fmt_fixed(qb), BAR_QFR_MARGIN,
+                                          fmt_fixed(None if qb is None else qb + BAR_QFR_MARGIN)),
+                     None if qa is None or qb is None else qa >= qb + BAR_QFR_MARGIN - 1e-12))
+        less_equal("mean Hausdorff ≤", "hausdorff", fmt_sci)
+        less_equal("mean Chamfer ≤", "chamfer", fmt_sci)
+        less_equal("mean PCCD ≤", "pccd", fmt_sci,
+                   lambda u, v: u.get("pccd_defined") == "true" and v.get("pccd_defined") == "true")
+        less_equal("mean flow deviation [°] ≤", "flow_deviation_deg", lambda v: fmt_fixed(v, 2))
+        wins, n = 0, 0
+        for x in both:
+            u, v = num(a[x].get("chamfer")), num(b[x].get("chamfer"))
+            if u is None or v is None:
+                continue
+            n += 1
+            if u <= v:
+                wins += 1
+            else:
+                losses.append((x, ratio, u, v))
+        crit.append(("Chamfer ≤ %s's on ≥ %d %% of meshes" % (lp, round(100 * BAR_CHAMFER_SHARE)),
+                     "%d / %d = %.1f %%" % (wins, n, 100.0 * wins / n) if n else "–", "",
+                     wins >= BAR_CHAMFER_SHARE * n - 1e-9 if n else None))
+        bad = [x for x in both if invalid_reasons(a[x])]
+        crit.append(("every output valid", "%d invalid of %d" % (len(bad), len(both)),
+                     "%d invalid" % sum(1 for x in both if invalid_reasons(b[x])), not bad))
+        out.append("| criterion | %s | %s | result |" % (lm, lp))
+        out.append("|---|---:|---:|---|")
+        for name, u, v, ok in crit:
+            out.append("| %s | %s | %s | %s |" % (name, u, v, "n/a" if ok is None else ("PASS" if ok else "FAIL")))
+        if bad:
+            out.append("")
+            out.extend("* invalid: %s: %s" % (x, "; ".join(invalid_reasons(a[x]))) for x in bad)
+        failed = sum(1 for c in crit if c[3] is False)
+        unknown = sum(1 for c in crit if c[3] is None)
+        verdicts[ratio] = failed == 0 and unknown == 0
+        out.append("")
+        out.append("**%s: %s** (%d of %d criteria failed%s)\n" % (
+            ratio_label(ratio).replace(" Δ", ""), "PASS" if verdicts[ratio] else "FAIL", failed,
+            len(crit), ", %d not measurable" % unknown if unknown else ""))
+    out.append("Chamfer losses (%s's Chamfer > %s's): %d\n" % (lm, lp, len(losses)))
+    if losses:
+        out.append("| mesh | ratio | %s Chamfer | %s Chamfer | %s / %s |" % (lm, lp, lm, lp))
+        out.append("|---|---:|---:|---:|---:|")
+        for x, ratio, u, v in sorted(losses, key=lambda l: (-float(l[1]), -(l[2] / l[3] if l[3] > 0 else math.inf))):
+            out.append("| %s | %s | %s | %s | %s |" % (x, ratio, fmt_sci(u), fmt_sci(v),
+                                                      "∞" if v <= 0 else "%.2f" % (u / v)))
+        out.append("")
+    checked = {k: v for k, v in verdicts.items() if v is not None}
+    out.append("**Bar %s vs %s: %s** (%s)\n" % (
+        lm, lp, "PASS" if checked and all(checked.values()) and len(checked) == len(verdicts) else "FAIL",
+        ", ".join("%s %s" % (ratio_label(k).replace(" Δ", ""),
+                             "n/a" if v is None else ("PASS" if v else "FAIL")) for k, v in verdicts.items())
+        or "no ratio checked"))
+    return out, verdicts
+
+
 def validity_section(rows):
     bad = []
     for r in rows:
         if r["status"] != "ok":
             continue
-        probs = []
-        if (num(r.get("nonmanifold_edges_new")) or 0) > 0:
-            probs.append("%d new non-manifold edges" % num(r["nonmanifold_edges_new"]))
-        for k in ("degenerate_faces", "duplicate_faces", "zero_length_edges"):
-            if (num(r.get(k)) or 0) > (num(r.get(k + "_in")) or 0):
-                probs.append("%s %d (input %d)" % (k.replace("_", " "), num(r[k]), num(r.get(k + "_in")) or 0))
-        if (num(r.get("flipped_faces")) or 0) > 0:
-            probs.append("%d flipped faces" % num(r["flipped_faces"]))
+        probs = invalid_reasons(r)
+        k = "zero_length_edges"  # listed here, not counted as invalid (Table 1, bar)
+        if (num(r.get(k)) or 0) > (num(r.get(k + "_in")) or 0):
+            probs.append("zero length edges %d (input %d)" % (num(r[k]), num(r.get(k + "_in")) or 0))
         if probs:
             bad.append((r, probs))
     out = ["## Validity: outputs worse than their input\n"]
     out.append("Outputs with new non-manifold edges, or more degenerate or duplicate faces than the "
-               "input, more zero-length edges (two vertices on one point), or faces flipped against the input surface (`flipped_faces`, docs/metrics.md §6b).\n")
+               "input, or faces flipped against the input surface (`flipped_faces`, docs/metrics.md "
+               "§6b): these count as *invalid* in Table 1 and the bar. Outputs with more zero-length "
+               "edges than the input (two vertices on one point) are listed too, but not counted.\n")
     if bad:
         out.append("| mesh | ratio | method | problems |")
         out.append("|---|---:|---|---|")
@@ -997,7 +1258,8 @@ def validity_section(rows):
 # ---------------------------------------------------------------------------------------------
 
 PLOT_METHODS = TABLE1_METHODS
-COLOURS = {"quadlod": "#1f77b4", "meshopt": "#ff7f0e", "meshlab": "#2ca02c",
+COLOURS = {"quadlod": "#1f77b4", "quadlod-greedy": "#17becf", "single": "#8c564b",
+           "single-rel": "#e377c2", "meshopt": "#ff7f0e", "meshlab": "#2ca02c",
            "blender-collapse": "#d62728", "blender-unsubdiv": "#9467bd"}
 
 
@@ -1135,8 +1397,9 @@ def plots_matplotlib(py, ratios, data, out_dir):
 def parse_args(argv):
     p = argparse.ArgumentParser(
         prog="bench/run",
-        description="quadlod, its ablations and the installed peers (meshoptimizer, MeshLab, "
-                    "Blender) side by side, all measured by `quadlod eval`.",
+        description="quadlod, its ablations and the installed peers (Single, meshoptimizer, "
+                    "MeshLab, Blender) side by side, all measured by `quadlod eval`, and the bar "
+                    "(quadlod against Single).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("--quick", action="store_true",
                    help="daily check: the --quick-meshes smallest meshes at ratio 0.4, every method, "
@@ -1171,6 +1434,13 @@ def parse_args(argv):
     p.add_argument("--build-peers", action="store_true",
                    help="configure build-bench/ and build quadlod_meshopt_peer first")
     p.add_argument("--blender", default="blender", help="Blender executable")
+    p.add_argument("--single", default=None,
+                   help="Single (Knodt 2025) decimate binary (default $QUADLOD_SINGLE, else "
+                        "../shared/peers/single/decimate)")
+    p.add_argument("--bar-method", default="quadlod",
+                   help="method(s) checked against the bar (comma-separated, e.g. "
+                        "quadlod,quadlod-greedy)")
+    p.add_argument("--bar-peer", default="single", help="the peer the bar compares against")
     p.add_argument("--meshlabserver", default="meshlabserver", help="meshlabserver executable")
     p.add_argument("--keep-meshes", action="store_true",
                    help="keep every output mesh under OUT/runs/ (default: deleted after eval)")
@@ -1217,6 +1487,10 @@ def parse_args(argv):
         elif m:
             p.error("--methods: unknown method %r (known: %s)" % (m, ", ".join(METHODS)))
     a.method_list = [m for m in METHODS if m in methods]
+    a.bar_methods = [m.strip() for m in a.bar_method.split(",") if m.strip()]
+    for m in a.bar_methods + [a.bar_peer]:
+        if m not in METHODS:
+            p.error("--bar-method/--bar-peer: unknown method %r (known: %s)" % (m, ", ".join(METHODS)))
     if not a.method_list:
         p.error("--methods selects nothing")
     if a.out is None:
@@ -1317,19 +1591,27 @@ def main(argv):
 
 def finish_reports(bench, settings):
     rows = list(bench.rows.values())
-    md = make_tables(rows, settings)
+    bar = []
+    for m in bench.args.bar_methods:
+        bar += bar_section(rows, m, bench.args.bar_peer)[0]
+    md = make_tables(rows, settings, bar)
     md_path = os.path.join(bench.out, "tables.md")
     write_atomic(md_path, md)
     log(plot_msg(bench, rows))
-    # Print Table 1 and Table 2 and the loss summary (not the long per-case list).
+    # Print Table 1 and Table 2 and the loss summary (not the long per-case list), then the bar.
     printing = True
+    in_bar = False
     for line in md.splitlines():
+        if line.startswith("## "):
+            in_bar = line.startswith("## Bar")
         if line.startswith("## Validity") or line.startswith("## Failed"):
             printing = False
         if line.startswith("| mesh | ratio | peer"):
             printing = False
-        if printing:
+        if printing and not in_bar:
             print(line)
+    for line in bar:
+        print(line)
     log("bench: wrote %s, %s" % (bench.csv_path, md_path))
 
 

@@ -399,8 +399,8 @@ TEST(ClusterCollapse, SingularQuadricOnFlatGridGivesFinitePositionInsideCluster)
   for (bool regular : {true, false}) {
     ClusterCollapseParams params;
     if (!regular) {
-      params.regularization = 0.0;
-      params.edge_plane_weight = 0.0;
+      params.placement.regularization = 0.0;
+      params.placement.edge_plane_weight = 0.0;
     }
     const ClusterCollapseResult r = collapse_clusters(in, conn, select(conn, block), params);
     expect_valid_output(in, r);
@@ -432,10 +432,10 @@ TEST(ClusterCollapse, UntrustedMinimiserFallsBackInsideTheCluster) {
   std::vector<std::uint8_t> kept(conn.num_edges, 1);
   for (auto& k : kept) k = (double(h() >> 11) * 0x1.0p-53) < 0.2 ? 0 : 1;
   ClusterCollapseParams bare;
-  bare.regularization = 0.0;
-  bare.edge_plane_weight = 0.0;
-  bare.eigen_cutoff = 0.0;
-  bare.preserve_volume = false;
+  bare.placement.regularization = 0.0;
+  bare.placement.edge_plane_weight = 0.0;
+  bare.placement.eigen_cutoff = 0.0;
+  bare.placement.preserve_volume = false;
   const double mean_edge = 1.0 / 12;
   for (bool use_bare : {true, false}) {
     const ClusterCollapseParams params = use_bare ? bare : ClusterCollapseParams{};
@@ -451,7 +451,7 @@ TEST(ClusterCollapse, UntrustedMinimiserFallsBackInsideTheCluster) {
     for (Index v = 0; v < in.num_vertices(); ++v)
       if (r.vertex_map[v] != kInvalidIndex) boxes[r.vertex_map[v]].extend(in.positions[v]);
     for (Index o = 0; o < r.mesh.num_vertices(); ++o) {
-      const double margin = params.bbox_margin * std::max(boxes[o].diagonal(), mean_edge) * 1.01;
+      const double margin = params.placement.bbox_margin * std::max(boxes[o].diagonal(), mean_edge) * 1.01;
       const Vec3& p = r.mesh.positions[o];
       EXPECT_TRUE((p.array() >= boxes[o].min.array() - margin).all() &&
                   (p.array() <= boxes[o].max.array() + margin).all())

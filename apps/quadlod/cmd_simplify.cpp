@@ -39,6 +39,17 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   ratio->excludes(faces);
   faces->excludes(ratio);
   SimplifyOptions& p = opt->pipeline;
+  sub->add_option("--objective", p.objective,
+                  "shape (the geometric error of the output, deterministic greedy) or paper (Eq. 9 with the MIP search)")
+      ->check(CLI::IsMember({"shape", "paper"}))->capture_default_str()->group("Objective");
+  sub->add_option("--lambda-shape", p.lambda_shape, "Weight of the quad-shape term of the shape objective (0 = error only)")
+      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_shape()))->group("Objective");
+  sub->add_option("--triangle-collapse-factor", p.triangle_collapse_factor,
+                  "Single edge collapses (they make triangles) compete at this multiple of their error (0 = none)")
+      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_triangle_collapse_factor()))->group("Objective");
+  sub->add_option("--max-triangle-share", p.max_triangle_share,
+                  "Largest share of the reduction that single collapses may make")
+      ->check(CLI::Range(0.0, 1.0))->default_str(std::to_string(default_max_triangle_share()))->group("Objective");
   sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget in seconds (0 = greedy selection only)")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Solver");
   sub->add_option("--threads", p.threads, "Solver threads: CBC's tree search, and the threads of annealing runs in the fast selection (0 = all cores)")

@@ -34,7 +34,17 @@ struct SimplifyOptions {
   /// < 0 = the measured default, 0 = the paper's objective.
   double lambda_tri = -1.0;
 
-  // --- solver -----------------------------------------------------------------------------------
+  // --- objective (issue "Shape first"; docs/formulation.md, "Shape objective") ----------------
+  /// "shape" (default): the selection minimises the geometric error of the mesh it produces
+  /// (cluster quadrics at the collapse's placement, plus the quad-shape term), by a deterministic
+  /// greedy (src/select/shape_selection.h). "paper": Eq. 9 with the MIP / annealing search
+  /// below (the paper's objective, for the ablation table).
+  std::string objective = "shape";
+  double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
+  double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = default, 0 = none
+  double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
+
+  // --- solver (objective "paper") --------------------------------------------------------------
   double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only
   int threads = 0;                  ///< solver threads (CBC; annealing runs of the fast selection); 0 = all cores
   std::uint32_t seed = 1;
@@ -119,5 +129,9 @@ double default_lambda_geo();
 double default_stall_seconds();
 double default_lambda_edge();
 double default_lambda_tri();
+/// The measured defaults of the shape objective (docs/parameters.md, "Shape objective").
+double default_lambda_shape();
+double default_triangle_collapse_factor();
+double default_max_triangle_share();
 
 }  // namespace quadlod

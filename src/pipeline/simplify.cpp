@@ -8,6 +8,7 @@
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
 #include "post/dual_repair.h"
+#include "select/shape_selection.h"
 #include "topology/analysis.h"
 #include "util/progress.h"
 
@@ -30,6 +31,9 @@ double default_lambda_geo() { return selection_defaults().lambda_geo; }
 double default_stall_seconds() { return selection_defaults().whole_stall_seconds; }
 double default_lambda_edge() { return selection_defaults().lambda_edge; }
 double default_lambda_tri() { return selection_defaults().lambda_tri; }
+double default_lambda_shape() { return ShapeSelectionParams{}.lambda_shape; }
+double default_triangle_collapse_factor() { return ShapeSelectionParams{}.triangle_collapse_factor; }
+double default_max_triangle_share() { return ShapeSelectionParams{}.max_triangle_share; }
 
 namespace {
 
@@ -190,8 +194,9 @@ struct PassOutcome {
 // One pass of the paper's pipeline on `input`, aiming at `target` triangle-equivalents, with
 // `time_limit` seconds of MIP budget for its first round.
 PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time_limit,
-                        const SimplifyOptions& options, SelectionParams sp, const DualRepairParams& dp,
-                        const ClusterCollapseParams& cp, StageLog& log, const std::string& pass_tag) {
+                        const SimplifyOptions& options, SelectionParams sp, ShapeSelectionParams shp,
+                        const DualRepairParams& dp, const ClusterCollapseParams& cp, StageLog& log,
+                        const std::string& pass_tag) {
   PassOutcome out;
   nlohmann::json& report = out.report;
 
@@ -273,8 +278,19 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     // so its collapsed edges are parts of segments, which Eq. 4 would keep whole — and lose.
     sp.consistency = options.consistency && !undoing;
     clock = Stopwatch();
-    const SelectionResult selection =
-        select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
+    // The objective (issue "Shape first"): the shape greedy by default, Eq. 9 with `paper`.
+    std::optional<ShapeSelectionStats> shape_stats;
+    SelectionResult selection;
+    if (options.objective == "shape") {
+      shp.keep_edges = sp.keep_edges;
+      shp.consistency = sp.consistency;
+      ShapeSelectionResult shaped =
+          select_by_shape(input, conn, analysis, static_cast<std::uint64_t>(selection_target), shp);
+      selection = std::move(shaped.selection);
+      shape_stats = shaped.stats;
+    } else {
+      selection = select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
+    }
     const double select_seconds = clock.seconds();
     out.seconds_select += select_seconds;
     log.done(2, "select", select_seconds,
@@ -351,6 +367,19 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
       report["selection"] = solve_json(selection);
       report["selection"]["seconds"] = select_seconds;
       report["selection"]["quads_to_triangles"] = predicted_new_triangles(input, conn, selection.edge_kept);
+      report["selection"]["objective_kind"] = options.objective;
+      if (shape_stats)
+        report["selection"]["shape"] = {
+            {"cost", shape_stats->cost},
+            {"error", shape_stats->error},
+            {"shape", shape_stats->shape},
+            {"segment_collapses", shape_stats->segment_collapses},
+            {"single_collapses", shape_stats->single_collapses},
+            {"reduced_by_segments", shape_stats->reduced_by_segments},
+            {"reduced_by_singles", shape_stats->reduced_by_singles},
+            {"evaluations", shape_stats->evaluations},
+            {"overshooting_moves", shape_stats->overshooting_moves},
+        };
       report["dual_repair"] = {
           {"seconds", repaired.seconds},
           {"super_faces_found", repaired.stats.super_faces_found},
@@ -454,9 +483,19 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   sp.solve.threads = options.threads;
   sp.solve.seed = options.seed;
   sp.quiet = !options.progress;
+  if (options.objective != "shape" && options.objective != "paper") {
+    result.error = "unknown objective '" + options.objective + "' (shape, paper)";
+    return result;
+  }
+  ShapeSelectionParams shp;
+  shp.epsilon_n = options.epsilon_n;
+  if (options.lambda_shape >= 0.0) shp.lambda_shape = options.lambda_shape;
+  if (options.triangle_collapse_factor >= 0.0) shp.triangle_collapse_factor = options.triangle_collapse_factor;
+  if (options.max_triangle_share >= 0.0) shp.max_triangle_share = options.max_triangle_share;
   DualRepairParams dp;
   dp.enable = options.dual_repair;
   ClusterCollapseParams cp;
+  shp.placement = cp.placement;  // the cost is priced where the collapse will place
   cp.max_hausdorff = options.max_hausdorff;
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
@@ -525,7 +564,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       }
       cp.face_island_area = &face_island_area;
     }
-    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, dp, cp, log, tag);
+    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag);
     cp.face_island_area = nullptr;
     if (!outcome.error.empty()) {
       result.error = outcome.error;
@@ -671,6 +710,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"pass_ratio", options.pass_ratio},
       {"max_passes", options.max_passes},
       {"greedy_fallback", options.greedy_fallback},
+      {"objective", options.objective},
+      {"lambda_shape", shp.lambda_shape},
+      {"triangle_collapse_factor", shp.triangle_collapse_factor},
+      {"max_triangle_share", shp.max_triangle_share},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +
@@ -691,7 +734,8 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   auto miss = [](const SimplifyResult& r) {
     return r.target ? std::abs(double(r.achieved) - double(r.target)) / double(r.target) : 0.0;
   };
-  if (!optimised.ok() || !options.greedy_fallback || !(options.time_limit_seconds > 0.0) ||
+  // The shape objective's selection is a greedy already: there is nothing to fall back to.
+  if (!optimised.ok() || options.objective != "paper" || !options.greedy_fallback || !(options.time_limit_seconds > 0.0) ||
       optimised.target >= optimised.input_tri_equivalent || miss(optimised) <= options.epsilon_n)
     return optimised;
   if (options.progress)

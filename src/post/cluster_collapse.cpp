@@ -38,13 +38,6 @@ namespace {
 
 constexpr std::uint8_t kNoReason = 0xFF;
 
-struct VertexTerms {
-  Quadric q;                  // face planes + edge planes through this vertex
-  Vec3 g = Vec3::Zero();      // Σ w·n       volume constraint: g·x = h
-  double h = 0.0;             // Σ w·(n·p)
-  double w = 0.0;             // Σ w         (scale for the degeneracy test of g)
-};
-
 // Area vector (Newell, shifted to the first corner against cancellation far from the origin).
 template <typename PositionOf>
 Vec3 area_vector(Index k, PositionOf&& at) {
@@ -52,14 +45,6 @@ Vec3 area_vector(Index k, PositionOf&& at) {
   Vec3 sum = Vec3::Zero();
   for (Index i = 1; i + 1 < k; ++i) sum += (at(i) - o).cross(at(i + 1) - o);
   return 0.5 * sum;
-}
-
-// q += w · (squared distance to the plane through p with unit normal n), without temporaries.
-inline void add_plane(Quadric& q, double w, const Vec3& p, const Vec3& n) {
-  const double d = -n.dot(p);
-  q.A.noalias() += (w * n) * n.transpose();
-  q.b += (w * d) * n;
-  q.c += w * d * d;
 }
 
 // A corner's turn: (next − cur) × (prev − cur); along +n at a convex corner of a CCW polygon.
@@ -401,81 +386,7 @@ Index Collapser::pieces_on_side(Index a, Index b) {
 //   * edge planes carry |e| · h / 2π instead of |e| / h, so edge and face terms have the same
 //     units (area) and, on a regular quad grid, the same ratio as in Knodt's code.
 void Collapser::build_vertex_terms() {
-  terms_.assign(nv_, VertexTerms{});
-  const double pi = std::numbers::pi;
-  const double face_w = std::max(0.0, params_.face_plane_weight);
-  const double edge_w = std::max(0.0, params_.edge_plane_weight);
-  const double feature_cos = std::cos(std::clamp(params_.feature_angle_deg, 0.0, 180.0) * pi / 180.0);
-
-  // Edge kind weight (Knodt): dihedral angle / π on manifold edges, floored; boundary and
-  // non-manifold edges heavy; sharp edges at least feature_edge_weight (ours).
-  std::vector<double> kind_w(ne_, 0.0);
-  for (Index e = 0; e < ne_; ++e) {
-    const Index count = conn_.edge_face_count(e);
-    double w;
-    if (count == 1) {
-      w = params_.boundary_edge_weight;
-    } else if (count > 2) {
-      w = params_.nonmanifold_edge_weight;
-    } else {
-      const auto cs = conn_.corners_of_edge(e);
-      const Vec3& n0 = face_n_[conn_.corner_face[cs[0]]];
-      const Vec3& n1 = face_n_[conn_.corner_face[cs[1]]];
-      w = params_.min_edge_weight;
-      if (n0.squaredNorm() > 0.0 && n1.squaredNorm() > 0.0) {
-        // Normals of consistently oriented neighbours: 0 on a flat edge, π folded flat.
-        const double cosang = std::clamp(n0.dot(n1), -1.0, 1.0);
-        w = std::max(w, std::acos(cosang) / pi);
-        if (cosang <= feature_cos) w = std::max(w, params_.feature_edge_weight);
-      }
-    }
-    kind_w[e] = std::max(0.0, std::max(w, params_.min_edge_weight));
-  }
-
-  const double edge_scale = edge_w * h_ / (2.0 * pi);
-  std::vector<double> angles;
-  for (Index f = 0; f < nf_; ++f) {
-    const double area = face_area_[f];
-    if (!(area > 0.0)) continue;  // no plane without a normal
-    const Vec3& n = face_n_[f];
-    const Index b = mesh_.face_begin(f), k = mesh_.face_size(f);
-    // Interior angles (unsigned, atan2 form: accurate near 0 and π).
-    double angle_sum = 0.0;
-    angles.resize(k);
-    for (Index i = 0; i < k; ++i) {
-      const Vec3& p = mesh_.positions[mesh_.corner_vertex[b + i]];
-      const Vec3 e0 = mesh_.positions[mesh_.corner_vertex[b + (i + k - 1) % k]] - p;
-      const Vec3 e1 = mesh_.positions[mesh_.corner_vertex[b + (i + 1) % k]] - p;
-      angles[i] = std::atan2(e0.cross(e1).norm(), e0.dot(e1));
-      angle_sum += angles[i];
-    }
-    for (Index i = 0; i < k; ++i) {
-      const Index c = b + i;
-      const Index v = mesh_.corner_vertex[c];
-      const Vec3& p = mesh_.positions[v];
-      const double wc = angle_sum > 0.0 ? area * angles[i] / angle_sum : area / k;
-      VertexTerms& t = terms_[v];
-      if (face_w > 0.0) add_plane(t.q, face_w * wc, p, n);
-      t.g += wc * n;
-      t.h += wc * n.dot(p);
-      t.w += wc;
-
-      // Knodt's edge plane: through edge(c), containing the face normal.
-      if (edge_scale <= 0.0) continue;
-      const Index w = conn_.tip_vertex(c);
-      if (w == v) continue;
-      const Vec3 d = mesh_.positions[w] - p;
-      const double len = d.norm();
-      Vec3 m = n.cross(d);
-      const double mlen = m.norm();
-      if (!(len > 0.0) || !(mlen > 0.0)) continue;
-      m /= mlen;
-      const double weight = edge_scale * kind_w[conn_.corner_edge[c]] * len;
-      if (!(weight > 0.0)) continue;
-      add_plane(t.q, weight, p, m);
-      add_plane(terms_[w].q, weight, p, m);  // the plane contains the edge: same plane at w
-    }
-  }
+  terms_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement).terms;
 }
 
 void Collapser::initial_clusters(const std::vector<std::uint8_t>& edge_kept) {
@@ -514,97 +425,27 @@ void Collapser::initial_clusters(const std::vector<std::uint8_t>& edge_kept) {
 
 // --- placement -----------------------------------------------------------------------------------
 
-// Minimiser of the cluster quadric Q (plus the centroid regulariser), solved around the centroid
-// x̄ so that directions Q leaves free stay at x̄:  x = x̄ + A⁻¹ (−A x̄ − b). Under volume
-// preservation (g·x = h) the Lagrange solution is x + A⁻¹g (h − g·x) / (g·A⁻¹g).
-// A is positive definite whenever regularization > 0; otherwise (or if ill-conditioned) the
-// inverse is the eigen pseudo-inverse with a relative cutoff. An untrusted result (non-finite,
-// or outside the cluster's box grown by bbox_margin) is replaced by the best of the centroid and
-// the members by quadric error.
+// The cluster's position: its feature line's where it touches one (place_on_feature), else the
+// minimiser of its quadric (geometry/cluster_quadric.h, the same placement the selection's shape
+// cost prices).
 void Collapser::place(Index r) {
   const auto ms = members(r);
-  Quadric q;
-  Vec3 g = Vec3::Zero(), centroid = Vec3::Zero(), psum = Vec3::Zero();
-  double hv = 0.0, wsum = 0.0, p2sum = 0.0;
-  BoundingBox box;
-  for (Index m : ms) {
-    const VertexTerms& t = terms_[m];
-    const Vec3& p = mesh_.positions[m];
-    q += t.q;
-    g += t.g;
-    hv += t.h;
-    wsum += t.w;
-    psum += p;
-    p2sum += p.squaredNorm();
-    box.extend(p);
-  }
-  const double n = static_cast<double>(ms.size());
-  centroid = psum / n;
-  const double wr = std::max(0.0, params_.regularization) * h_ * h_;
-  if (wr > 0.0) {  // Σ_m wr |x − p_m|²
-    q.A.diagonal().array() += wr * n;
-    q.b -= wr * psum;
-    q.c += wr * p2sum;
-  }
-  if (features_on_ && place_on_feature(r, q)) {
-    placed_round_[r] = round_;
-    return;
-  }
-
-  const double cutoff = std::max(0.0, params_.eigen_cutoff);
-  Eigen::LDLT<Eigen::Matrix3d> ldlt(q.A);
-  const bool direct = ldlt.info() == Eigen::Success && ldlt.isPositive() &&
-                      ldlt.vectorD().minCoeff() > 0.0 && ldlt.rcond() > cutoff;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  double lambda_cut = 0.0;
-  if (!direct) {
-    ++stats_.placements_pseudo_inverse;
-    eig.compute(q.A);
-    lambda_cut = cutoff * std::max(eig.eigenvalues().cwiseAbs().maxCoeff(), 0.0);
-  }
-  auto apply_inverse = [&](const Vec3& v) -> Vec3 {
-    if (direct) return ldlt.solve(v);
-    Vec3 x = Vec3::Zero();
-    for (int i = 0; i < 3; ++i) {
-      const double l = eig.eigenvalues()[i];
-      if (l > lambda_cut && l > 0.0) {
-        const Vec3 u = eig.eigenvectors().col(i);
-        x += u * (u.dot(v) / l);
-      }
-    }
-    return x;
-  };
-
-  Vec3 x = centroid + apply_inverse(-(q.A * centroid + q.b));
-  if (params_.preserve_volume && g.norm() > 1e-9 * wsum) {
-    const Vec3 ag = apply_inverse(g);
-    const double den = g.dot(ag);
-    if (den > 0.0 && std::isfinite(den)) {
-      const Vec3 xv = x + ag * ((hv - g.dot(x)) / den);
-      if (xv.allFinite()) {
-        x = xv;
-        ++stats_.placements_volume_constrained;
-      }
+  ClusterTerms t;
+  for (Index m : ms) t.add_vertex(terms_[m], mesh_.positions[m]);
+  if (features_on_) {
+    // place_on_feature minimises the regularised quadric along the line.
+    if (place_on_feature(r, regularized_quadric(t, h_, params_.placement))) {
+      placed_round_[r] = round_;
+      return;
     }
   }
-
-  const double margin = std::max(0.0, params_.bbox_margin) * std::max(box.diagonal(), h_);
-  const bool inside = x.allFinite() && (x.array() >= box.min.array() - margin).all() &&
-                      (x.array() <= box.max.array() + margin).all();
-  if (!inside) {
-    ++stats_.placements_fallback;
-    Vec3 best = centroid;
-    double best_err = q(centroid);
-    for (Index m : ms) {
-      const double err = q(mesh_.positions[m]);
-      if (err < best_err) {
-        best_err = err;
-        best = mesh_.positions[m];
-      }
-    }
-    x = best;
-  }
-  pos_[r] = x;
+  const ClusterPlacement pl = place_cluster(t, h_, params_.placement, [&](auto&& visit) {
+    for (Index m : ms) visit(mesh_.positions[m]);
+  });
+  stats_.placements_pseudo_inverse += pl.pseudo_inverse;
+  stats_.placements_volume_constrained += pl.volume_constrained;
+  stats_.placements_fallback += pl.fallback;
+  pos_[r] = pl.position;
   placed_round_[r] = round_;
 }
 

@@ -37,6 +37,7 @@
 #pragma once
 
 #include "geometry/bvh.h"
+#include "geometry/cluster_quadric.h"
 #include "mesh/connectivity.h"
 #include "mesh/features.h"
 #include "quadlod/mesh.h"
@@ -71,42 +72,8 @@ struct SurfaceReference {
 SurfaceReference make_surface_reference(const PolyMesh& mesh);
 
 struct ClusterCollapseParams {
-  // --- placement: the cluster quadric ---------------------------------------------------------
-  // All weights are dimensionless multipliers of terms that are scaled to the mesh: face planes
-  // carry area (a corner's share of its face's area, split by interior angle), edge planes carry
-  // |edge| · h / 2π with h the mean input edge length, which reproduces Knodt's ratio of edge to
-  // face weight on a regular quad grid (see docs/cluster_collapse.md).
-
-  /// Multiplier of the face-plane quadrics (Garland–Heckbert), >= 0.
-  double face_plane_weight = 1.0;
-  /// Multiplier of all edge-plane quadrics (the plane through an edge that contains the face
-  /// normal, Knodt 2025), >= 0. 0 turns off every edge plane, boundary ones included.
-  double edge_plane_weight = 1.0;
-  /// Weight of a manifold edge's planes is dihedral angle / π (0 flat … 1 folded flat), but at
-  /// least this (Knodt's `min_edge_weight`): keeps flat regions evenly spaced.
-  double min_edge_weight = 0.01;
-  /// Weight of the planes of an open-boundary edge (Knodt: 4): keeps boundaries from shrinking.
-  double boundary_edge_weight = 4.0;
-  /// Weight of the planes of a non-manifold edge (Knodt: 4).
-  double nonmanifold_edge_weight = 4.0;
-  /// Manifold edges with a dihedral angle of at least this many degrees are sharp features and
-  /// get at least `feature_edge_weight`, as heavy as a boundary (our addition; Knodt only uses
-  /// dihedral / π, i.e. 0.5 for a 90° crease). 60° is the paper's ϵ_θ (§3.2.2).
-  double feature_angle_deg = 60.0;
-  double feature_edge_weight = 4.0;
-  /// Pull toward the cluster centroid: each member adds regularization · h² · |x − p_member|².
-  /// Makes the 3×3 system positive definite in flat and straight regions. >= 0.
-  double regularization = 1e-3;
-  /// Minimise subject to Lindstrom–Turk volume preservation (the signed volume swept between the
-  /// members' face planes and the new vertex is zero), as Knodt's code does. Skipped where the
-  /// constraint is degenerate.
-  bool preserve_volume = true;
-  /// Eigenvalues below this fraction of the largest are treated as zero (pseudo-inverse around
-  /// the centroid) when the direct solve is ill-conditioned.
-  double eigen_cutoff = 1e-6;
-  /// A minimiser outside the cluster's bounding box enlarged by this fraction of max(box
-  /// diagonal, h) is not trusted: the best of {centroid, members} by quadric error is used.
-  double bbox_margin = 0.5;
+  // --- placement: the cluster quadric (geometry/cluster_quadric.h) -------------------------
+  QuadricPlacementParams placement;
 
   // --- guarantees -----------------------------------------------------------------------------
   /// An output face whose normal is more than this many degrees away from the normal of the

@@ -1,0 +1,451 @@
+// Shape-first edge selection: a lazy greedy over segment collapses (paper §3.2.2, Eq. 4 units)
+// priced by the geometric error of the clusters they create (§3.3.2 quadrics and placement,
+// Knodt 2025 per-edge planes) and by the shape of the quads around them.
+//
+//   before                     after collapsing segment s (its opposing edges ┃)
+//   ──●────●────●────●──        ──●─────────●────●──
+//     │    ┃    │    │            │         │    │      the two rows of vertices along ┃ merge
+//   ──●────●────●────●──        ──●─────────●────●──    pairwise; each merged pair is a cluster
+//     │    ┃    │    │            │         │    │      placed at its quadric's minimiser; the
+//   ──●────●────●────●──        ──●─────────●────●──    quads beside s get wider (shape term)
+//
+// The incremental state keeps, per cluster root, the summed quadric terms, the placed position
+// and its error; per face, its kept edges (Eq. 1 counts the face as max(0, kept − 2)).
+#include "select/shape_selection.h"
+
+#include "mesh/union_find.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <queue>
+#include <span>
+
+namespace quadlod {
+
+namespace {
+
+// Decision units: the opposing edges of a segment (joined through shared non-manifold edges),
+// every other edge on its own — the groups of the fast formulation.
+struct Units {
+  Index count = 0;
+  std::vector<Index> edge_unit, offsets, edges;
+  std::vector<std::uint8_t> fixed;  // 1: never collapsed as a unit
+  std::span<const Index> of(Index u) const { return {edges.data() + offsets[u], std::size_t(offsets[u + 1] - offsets[u])}; }
+};
+
+Units make_units(const Connectivity& conn, const AnalysisResult& analysis, const ShapeSelectionParams& params,
+                 const std::vector<std::uint8_t>& pinned) {
+  UnionFind uf(conn.num_edges);
+  if (params.consistency)
+    for (const Segment& s : analysis.segmentation.segments)
+      for (std::size_t i = 1; i < s.opposing_edges.size(); ++i) uf.unite(s.opposing_edges[0], s.opposing_edges[i]);
+  Units u;
+  u.edge_unit = uf.dense_labels(u.count);
+  u.offsets.assign(std::size_t(u.count) + 1, 0);
+  for (Index e = 0; e < conn.num_edges; ++e) ++u.offsets[u.edge_unit[e] + 1];
+  std::partial_sum(u.offsets.begin(), u.offsets.end(), u.offsets.begin());
+  u.edges.resize(conn.num_edges);
+  std::vector<Index> fill(u.offsets.begin(), u.offsets.end() - 1);
+  for (Index e = 0; e < conn.num_edges; ++e) u.edges[fill[u.edge_unit[e]]++] = e;
+  u.fixed.assign(u.count, 0);
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (pinned[e]) u.fixed[u.edge_unit[e]] = 1;
+  return u;
+}
+
+// Pinned edges: the caller's keep list and (optionally) non-manifold edges.
+std::vector<std::uint8_t> pinned_edges(const Connectivity& conn, const ShapeSelectionParams& params) {
+  std::vector<std::uint8_t> pinned(conn.num_edges, 0);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    if (params.keep_nonmanifold_edges && conn.is_nonmanifold_edge(e)) pinned[e] = 1;
+    if (!params.keep_edges.empty() && params.keep_edges[e]) pinned[e] = 1;
+    const auto [a, b] = conn.edge_vertices[e];
+    if (a == b) pinned[e] = 1;
+  }
+  return pinned;
+}
+
+// What collapsing a set of kept edges would change.
+struct Move {
+  std::int64_t reduced = 0;  // triangle-equivalents removed (Eq. 1)
+  double error = 0.0;        // Δ Σ cluster errors (raw units)
+  double shape = 0.0;        // Δ Σ quad-shape penalties (raw units, before λ_shape)
+  double cost(double lambda_shape) const { return error + lambda_shape * shape; }
+};
+
+class ShapeState {
+ public:
+  ShapeState(const PolyMesh& mesh, const Connectivity& conn, const ShapeSelectionParams& params)
+      : mesh_(mesh), conn_(conn), params_(params), uf_(mesh.num_vertices()) {
+    const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
+    const VertexQuadrics vq = build_vertex_quadrics(mesh, conn, params.placement);
+    h_ = vq.mean_edge;
+    terms_.resize(nv);
+    for (Index v = 0; v < nv; ++v) terms_[v].add_vertex(vq.terms[v], mesh.positions[v]);
+    err_.assign(nv, 0.0);  // a lone vertex sits on all of its planes
+    pos_ = mesh.positions;
+    next_member_.resize(nv);
+    std::iota(next_member_.begin(), next_member_.end(), Index{0});  // circular member lists
+    kept_.assign(conn.num_edges, 1);
+    face_kept_.assign(nf, 0);
+    log_aspect0_.assign(nf, 0.0);
+    pen_.assign(nf, 0.0);
+    double area = 0.0;
+    for (Index f = 0; f < nf; ++f) {
+      face_kept_[f] = mesh.face_size(f);
+      area += face_area_vector(mesh, f).norm();
+      if (mesh.face_size(f) == 4) log_aspect0_[f] = log_aspect(f, [&](Index v) -> const Vec3& { return mesh.positions[v]; });
+    }
+    const double diag = bounding_box(mesh).diagonal();
+    norm_ = (area > 0.0 ? area : 1.0) * (diag > 0.0 ? diag * diag : 1.0);
+    for (Index f = 0; f < nf; ++f) count_ += face_count(f, face_kept_[f]);
+    root_token_.assign(nv, 0);
+    root_local_.assign(nv, 0);
+    face_token_.assign(nf, 0);
+    face_removed_.assign(nf, 0);
+  }
+
+  std::int64_t count() const { return count_; }
+  double error() const { return error_; }
+  double shape() const { return shape_; }
+  double normalisation() const { return norm_; }
+  bool kept(Index e) const { return kept_[e] != 0; }
+  const std::vector<std::uint8_t>& edge_kept() const { return kept_; }
+
+  // Prices collapsing the kept edges among `edges`; the scratch then holds the move for apply().
+  Move evaluate(std::span<const Index> edges) {
+    ++token_;
+    locals_.clear();
+    local_parent_.clear();
+    moved_edges_.clear();
+    for (Index e : edges) {
+      if (!kept_[e]) continue;
+      moved_edges_.push_back(e);
+      const auto [a, b] = conn_.edge_vertices[e];
+      const Index la = local_of(uf_.find(a)), lb = local_of(uf_.find(b));
+      unite_local(la, lb);
+    }
+    Move m;
+    if (moved_edges_.empty()) return m;
+
+    // New clusters: the sums of their old clusters' terms, placed.
+    set_of_.assign(locals_.size(), kInvalidIndex);
+    sets_.clear();
+    for (std::size_t i = 0; i < locals_.size(); ++i) {
+      const Index r = find_local(Index(i));
+      if (set_of_[r] == kInvalidIndex) {
+        set_of_[r] = Index(sets_.size());
+        sets_.push_back({});
+      }
+      NewCluster& s = sets_[set_of_[r]];
+      s.terms += terms_[locals_[i]];
+      s.roots.push_back(locals_[i]);
+      m.error -= err_[locals_[i]];
+    }
+    for (NewCluster& s : sets_) {
+      s.placement = place_cluster(s.terms, h_, params_.placement, [&](auto&& visit) {
+        for (Index r : s.roots) for_each_member(r, [&](Index v) { visit(mesh_.positions[v]); });
+      });
+      m.error += s.placement.error;
+    }
+
+    // Eq. 1: faces along the collapsed edges lose kept edges.
+    touched_faces_.clear();
+    for (Index e : moved_edges_)
+      for (Index c : conn_.corners_of_edge(e)) {
+        const Index f = conn_.corner_face[c];
+        if (face_token_[f] != token_) {
+          face_token_[f] = token_;
+          face_removed_[f] = 0;
+          touched_faces_.push_back(f);
+        }
+        ++face_removed_[f];
+      }
+    for (Index f : touched_faces_)
+      m.reduced += face_count(f, face_kept_[f]) - face_count(f, face_kept_[f] - face_removed_[f]);
+
+    // Quad shapes: every face with a corner in a merged cluster (its corners move).
+    if (params_.lambda_shape > 0.0) {
+      ++face_tok2_;
+      if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
+      shape_faces_.clear();
+      for (const NewCluster& s : sets_)
+        for (Index r : s.roots)
+          for_each_member(r, [&](Index v) {
+            for (Index c : conn_.corners_at_vertex(v)) {
+              const Index f = conn_.corner_face[c];
+              if (face_token2_[f] == face_tok2_) continue;
+              face_token2_[f] = face_tok2_;
+              shape_faces_.push_back(f);
+            }
+          });
+      for (Index f : shape_faces_) {
+        const Index removed = face_token_[f] == token_ ? face_removed_[f] : 0;
+        const double after = penalty(f, face_kept_[f] - removed, [&](Index v) -> const Vec3& {
+          const Index r = uf_.find(v);
+          if (root_token_[r] == token_) return sets_[set_of_[find_local(root_local_[r])]].placement.position;
+          return pos_[r];
+        });
+        m.shape += after - pen_[f];
+      }
+    }
+    return m;
+  }
+
+  // Applies the move last priced by evaluate().
+  void apply(const Move& m) {
+    for (Index e : moved_edges_) kept_[e] = 0;
+    for (Index f : touched_faces_) face_kept_[f] -= face_removed_[f];
+    count_ -= m.reduced;
+    error_ += m.error;
+    for (NewCluster& s : sets_) {
+      Index root = s.roots[0];
+      for (std::size_t i = 1; i < s.roots.size(); ++i) {
+        const Index joined = uf_.unite(root, s.roots[i]);
+        std::swap(next_member_[root], next_member_[s.roots[i]]);  // splice the circular lists
+        root = joined;
+      }
+      root = uf_.find(root);
+      terms_[root] = s.terms;
+      err_[root] = s.placement.error;
+      pos_[root] = s.placement.position;
+    }
+    if (params_.lambda_shape > 0.0) {
+      for (Index f : shape_faces_) {
+        const double p = penalty(f, face_kept_[f], [&](Index v) -> const Vec3& { return pos_[uf_.find(v)]; });
+        shape_ += p - pen_[f];
+        pen_[f] = p;
+      }
+    }
+  }
+
+ private:
+  struct NewCluster {
+    ClusterTerms terms;
+    std::vector<Index> roots;
+    ClusterPlacement placement;
+  };
+
+  static std::int64_t face_count(Index /*f*/, Index kept) { return kept > 2 ? kept - 2 : 0; }
+
+  template <class PositionOf>
+  double log_aspect(Index f, PositionOf&& at) const {
+    const Index b = mesh_.face_begin(f);
+    const Vec3& p0 = at(mesh_.corner_vertex[b]);
+    const Vec3& p1 = at(mesh_.corner_vertex[b + 1]);
+    const Vec3& p2 = at(mesh_.corner_vertex[b + 2]);
+    const Vec3& p3 = at(mesh_.corner_vertex[b + 3]);
+    const double a = (p1 - p0).norm() + (p3 - p2).norm(), c = (p2 - p1).norm() + (p0 - p3).norm();
+    return a > 0.0 && c > 0.0 ? std::log(a / c) : 0.0;
+  }
+
+  // A quad's shape penalty, A h² (ln aspect − ln aspect⁰)², with the quad's sides measured
+  // between its placed corners and the input's aspect measured across the same corner pairs;
+  // 0 for anything that is no longer a quad of four distinct clusters.
+  template <class PositionOf>
+  double penalty(Index f, Index kept, PositionOf&& at) {
+    if (mesh_.face_size(f) != 4 || kept != 4) return 0.0;
+    const Index b = mesh_.face_begin(f);
+    Index r[4];
+    for (int i = 0; i < 4; ++i) r[i] = uf_.find(mesh_.corner_vertex[b + i]);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        if (r[i] == r[j]) return 0.0;
+    const double d = log_aspect(f, at) - log_aspect0_[f];
+    const Vec3& p0 = at(mesh_.corner_vertex[b]);
+    const Vec3 area = 0.5 * (at(mesh_.corner_vertex[b + 2]) - p0).cross(at(mesh_.corner_vertex[b + 3]) - at(mesh_.corner_vertex[b + 1]));
+    return area.norm() * h_ * h_ * d * d;
+  }
+
+  template <class F>
+  void for_each_member(Index r, F&& f) const {
+    Index v = r;
+    do {
+      f(v);
+      v = next_member_[v];
+    } while (v != r);
+  }
+
+  Index local_of(Index root) {
+    if (root_token_[root] != token_) {
+      root_token_[root] = token_;
+      root_local_[root] = Index(locals_.size());
+      locals_.push_back(root);
+      local_parent_.push_back(Index(local_parent_.size()));
+    }
+    return root_local_[root];
+  }
+  Index find_local(Index x) {
+    while (local_parent_[x] != x) x = local_parent_[x] = local_parent_[local_parent_[x]];
+    return x;
+  }
+  void unite_local(Index a, Index b) {
+    a = find_local(a);
+    b = find_local(b);
+    if (a != b) local_parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+  const PolyMesh& mesh_;
+  const Connectivity& conn_;
+  const ShapeSelectionParams& params_;
+  UnionFind uf_;
+  double h_ = 1.0, norm_ = 1.0;
+  std::vector<ClusterTerms> terms_;  // per root
+  std::vector<double> err_;          // per root
+  std::vector<Vec3> pos_;            // per root
+  std::vector<Index> next_member_;
+  std::vector<std::uint8_t> kept_;
+  std::vector<Index> face_kept_;
+  std::vector<double> log_aspect0_, pen_;
+  std::int64_t count_ = 0;
+  double error_ = 0.0, shape_ = 0.0;
+
+  // Scratch of the last evaluate().
+  Index token_ = 0, face_tok2_ = 0;
+  std::vector<Index> root_token_, root_local_, face_token_, face_removed_, face_token2_;
+  std::vector<Index> locals_, local_parent_, set_of_, moved_edges_, touched_faces_, shape_faces_;
+  std::vector<NewCluster> sets_;
+};
+
+// A candidate of the greedy: a unit (segment) collapse, or a single edge collapse.
+struct Candidate {
+  double priority;
+  Index id;  // < units: unit; else units + edge
+  std::int64_t version;
+  bool operator<(const Candidate& o) const {  // std::priority_queue is a max-heap
+    if (priority != o.priority) return priority > o.priority;
+    return id > o.id;
+  }
+};
+
+std::uint64_t lower_band(std::uint64_t target, double eps) {
+  return static_cast<std::uint64_t>(std::ceil((1.0 - eps) * double(target) - 1e-9));
+}
+
+}  // namespace
+
+ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                     std::uint64_t target, const ShapeSelectionParams& params) {
+  ShapeSelectionResult out;
+  SelectionResult& sel = out.selection;
+  ShapeSelectionStats& st = out.stats;
+  sel.strategy = "shape-greedy";
+  sel.stop_reason = "greedy";
+  sel.target = target;
+  const std::vector<std::uint8_t> pinned = pinned_edges(conn, params);
+  const Units units = make_units(conn, analysis, params, pinned);
+  ShapeState state(mesh, conn, params);
+  sel.input_tri_equivalent = std::uint64_t(state.count());
+  if (target >= sel.input_tri_equivalent) {
+    sel.edge_kept = state.edge_kept();
+    sel.predicted = sel.greedy_predicted = sel.input_tri_equivalent;
+    sel.note = "target at or above the input size: nothing to do";
+    sel.stop_reason = "nothing to do";
+    sel.band_enforced = true;
+    return out;
+  }
+  const std::int64_t lo = std::int64_t(lower_band(target, params.epsilon_n));
+  const double single_factor = params.triangle_collapse_factor;
+  const bool singles = params.consistency && single_factor > 0.0 && params.max_triangle_share > 0.0;
+  const std::int64_t single_budget =
+      singles ? std::int64_t(params.max_triangle_share * double(sel.input_tri_equivalent - target)) : 0;
+  const Index nu = units.count;
+
+  // A single collapse is a candidate where it differs from its unit's collapse.
+  auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.edge_unit[e]).size() > 1; };
+  auto edges_of = [&](Index id) -> std::span<const Index> {
+    return id < nu ? units.of(id) : std::span<const Index>(&units.edges[0], 0);
+  };
+  Index single_scratch = 0;
+  auto move_edges = [&](Index id) -> std::span<const Index> {
+    if (id < nu) return edges_of(id);
+    single_scratch = id - nu;
+    return {&single_scratch, 1};
+  };
+  auto priority = [&](Index id, const Move& m) {
+    const double per = m.cost(params.lambda_shape) / double(m.reduced);
+    // A handicap that also holds for gains (negative cost): a single collapse is taken only when
+    // it is better by the factor.
+    if (id < nu) return per;
+    return per >= 0.0 ? per * single_factor : per / single_factor;
+  };
+
+  std::priority_queue<Candidate> heap;
+  std::int64_t version = 0;
+  auto consider = [&](Index id) {
+    const Move m = state.evaluate(move_edges(id));
+    ++st.evaluations;
+    if (m.reduced > 0) heap.push({priority(id, m), id, version});
+  };
+  for (Index u = 0; u < nu; ++u)
+    if (!units.fixed[u]) consider(u);
+  if (singles)
+    for (Index e = 0; e < conn.num_edges; ++e)
+      if (single_edge(e)) consider(nu + e);
+
+  while (state.count() > std::int64_t(target) && !heap.empty()) {
+    const Candidate top = heap.top();
+    heap.pop();
+    if (top.id >= nu && st.reduced_by_singles >= std::uint64_t(single_budget)) continue;
+    const Move m = state.evaluate(move_edges(top.id));
+    if (top.version != version) ++st.evaluations;
+    if (m.reduced <= 0) continue;
+    const double p = priority(top.id, m);
+    if (top.version != version && !heap.empty() && p > heap.top().priority) {
+      heap.push({p, top.id, version});  // stale and now worse than the next: later
+      continue;
+    }
+    if (state.count() - m.reduced < lo) {
+      ++st.overshooting_moves;  // N' only falls: this move can never fit again
+      continue;
+    }
+    if (top.id >= nu && st.reduced_by_singles + std::uint64_t(m.reduced) > std::uint64_t(single_budget)) continue;
+    state.apply(m);
+    ++version;
+    if (top.id < nu) {
+      ++st.segment_collapses;
+      st.reduced_by_segments += std::uint64_t(m.reduced);
+    } else {
+      ++st.single_collapses;
+      st.reduced_by_singles += std::uint64_t(m.reduced);
+    }
+  }
+
+  sel.edge_kept = state.edge_kept();
+  sel.predicted = sel.greedy_predicted = std::uint64_t(state.count());
+  const std::int64_t band_hi = std::int64_t(std::floor((1.0 + params.epsilon_n) * double(target) + 1e-9));
+  sel.band_enforced = state.count() >= lo && state.count() <= band_hi;
+  if (!sel.band_enforced)
+    sel.note = "no selection within " + std::to_string(int(std::lround(params.epsilon_n * 100))) +
+               " % of the target was found by the shape greedy (closest N' " + std::to_string(state.count()) + ")";
+  for (Index u = 0; u < nu; ++u) {
+    bool all = true;
+    for (Index e : units.of(u)) all = all && !state.kept(e);
+    sel.collapsed_groups += all;
+  }
+  st.error = state.error() / state.normalisation();
+  st.shape = state.shape() / state.normalisation();
+  st.cost = st.error + params.lambda_shape * st.shape;
+  sel.objective = sel.greedy_objective = st.cost;
+  return out;
+}
+
+ShapeSelectionStats shape_cost(const PolyMesh& mesh, const Connectivity& conn, const std::vector<std::uint8_t>& edge_kept,
+                               const ShapeSelectionParams& params) {
+  // From scratch: the collapsed edges applied one by one — the incremental deltas add up to the
+  // cost of the final state whatever the order, so this is the oracle of the greedy's figures.
+  ShapeState state(mesh, conn, params);
+  ShapeSelectionStats st;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    if (edge_kept[e]) continue;
+    const Index one[1] = {e};
+    state.apply(state.evaluate(one));
+  }
+  st.error = state.error() / state.normalisation();
+  st.shape = state.shape() / state.normalisation();
+  st.cost = st.error + params.lambda_shape * st.shape;
+  return st;
+}
+
+}  // namespace quadlod

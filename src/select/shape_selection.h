@@ -1,0 +1,93 @@
+// Shape-first edge selection (issue "Shape first"; beyond the paper's Eq. 9): which input edges
+// to collapse so that the reduced mesh has about N triangle-equivalents and the least geometric
+// error — the error of the mesh the collapse will actually produce, not a proxy of it.
+//
+// Decision units are the paper's: the opposing edges of a poly-chord segment collapse together
+// (§3.2.2, Eq. 4), so a collapse removes a strip of quads and keeps the quad layout. The cost of
+// a selection is
+//
+//     cost = Σ_clusters E(cluster)                       (geometric error)
+//          + λ_shape Σ_quads A_f h² (ln aspect_f − ln aspect_f⁰)²   (quad shape)
+//
+// where the clusters are the union-find components of the collapsed edges (§3.3.2), E is the
+// cluster quadric (geometry/cluster_quadric.h: the very quadrics and placement of
+// post/cluster_collapse, Knodt's per-edge planes included) at its placed vertex, and the shape
+// term compares each surviving quad's aspect ratio (placed corners) with its input face's. The
+// reported figures divide by (input area × bbox diagonal²): an area-weighted mean squared
+// distance in units of the diagonal squared.
+//
+// The search is a lazy greedy in error per triangle-equivalent removed, with exact incremental
+// deltas: a move merges the clusters its edges join, and its delta is the change of those
+// clusters' errors (and of the shapes of the quads around them). Where every remaining segment
+// costs far more per triangle-equivalent than a single edge collapse would, single collapses that
+// make triangles (as Single, Knodt 2025, does) compete too, handicapped by
+// triangle_collapse_factor and capped at max_triangle_share of the reduction.
+//
+// Deterministic: no clock, no threads, ties broken by id. The paper's Eq. 9 selection stays in
+// select_edges() (`--objective paper`).
+#pragma once
+
+#include "geometry/cluster_quadric.h"
+#include "ilp/formulation.h"
+#include "mesh/connectivity.h"
+#include "quadlod/mesh.h"
+#include "topology/analysis.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace quadlod {
+
+struct ShapeSelectionParams {
+  /// ϵ_N of Eq. 2: the selection never goes below (1 − epsilon_n)·N. The paper's value.
+  double epsilon_n = 0.03;
+  /// Eq. 4 on/off: false decides every edge on its own (the "w/o consistency" ablation).
+  bool consistency = true;
+  /// Edges with more than two faces are never collapsed (the collapse would join sheets).
+  bool keep_nonmanifold_edges = true;
+  /// Edges that must be kept, one entry per Connectivity edge (nonzero = keep); empty = none.
+  /// Pinning an edge keeps its whole segment (Eq. 4), but not against single collapses of the
+  /// segment's other edges.
+  std::vector<std::uint8_t> keep_edges;
+  /// The placement the collapse will use (ClusterCollapseParams::placement): the cost is priced
+  /// at the same positions.
+  QuadricPlacementParams placement;
+  /// λ_shape: weight of the quad-shape term (see above); 0 = geometric error alone.
+  double lambda_shape = 0.05;
+  /// A single edge collapse (it makes triangles of the quads beside it) competes with segment
+  /// collapses at this multiple of its error per triangle-equivalent; 0 disables them.
+  double triangle_collapse_factor = 8.0;
+  /// At most this share of the reduction (input − N triangle-equivalents) comes from single
+  /// collapses.
+  double max_triangle_share = 0.25;
+};
+
+struct ShapeSelectionStats {
+  double cost = 0.0;            ///< the selection's cost, normalised (see above)
+  double error = 0.0;           ///< its geometric part
+  double shape = 0.0;           ///< its quad-shape part
+  Index segment_collapses = 0;  ///< group (segment) collapses taken
+  Index single_collapses = 0;   ///< single edge collapses taken
+  std::uint64_t reduced_by_segments = 0;  ///< triangle-equivalents removed by segment collapses
+  std::uint64_t reduced_by_singles = 0;   ///< … by single collapses
+  std::int64_t evaluations = 0;           ///< move evaluations (the greedy's work)
+  Index overshooting_moves = 0;           ///< moves dropped: they would leave Eq. 2's band below
+};
+
+struct ShapeSelectionResult {
+  /// edge_kept, counts and note as select_edges() fills them (strategy "shape-greedy").
+  SelectionResult selection;
+  ShapeSelectionStats stats;
+};
+
+/// Selects the edges to collapse for a reduction to `target` triangle-equivalents by the shape
+/// cost. `analysis` must come from analyze() on the same mesh and connectivity.
+ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
+                                     std::uint64_t target, const ShapeSelectionParams& params = {});
+
+/// The shape cost (normalised, as ShapeSelectionStats::cost) of any selection, computed from
+/// scratch: for tests and for comparing selections made by other objectives.
+ShapeSelectionStats shape_cost(const PolyMesh& mesh, const Connectivity& conn,
+                               const std::vector<std::uint8_t>& edge_kept, const ShapeSelectionParams& params = {});
+
+}  // namespace quadlod

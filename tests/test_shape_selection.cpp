@@ -1,0 +1,159 @@
+// The shape-first selection (src/select/shape_selection.h): known answers on hand-made meshes,
+// the incremental cost against its from-scratch oracle, determinism and the single-collapse cap.
+#include "select/shape_selection.h"
+
+#include "quadlod/generators.h"
+#include "quadlod/simplify.h"
+#include "topology/analysis.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+using namespace quadlod;
+
+namespace {
+
+struct Prepared {
+  PolyMesh mesh;
+  Connectivity conn;
+  AnalysisResult analysis;
+};
+
+Prepared prepare(PolyMesh mesh) {
+  Prepared p{std::move(mesh), {}, {}};
+  p.conn = build_connectivity(p.mesh);
+  p.analysis = analyze(p.mesh, p.conn);
+  return p;
+}
+
+// An 8×3 grid of unit cells with a ridge along y (the vertices on x = 4 lifted by 1), bent
+// across y (z += 0.3 (y − 1.5)²), so that the surface is straight along x away from the ridge
+// and curved along y everywhere:
+//
+//   z  ridge            columns 0 … 7 (quads between x = i and x = i + 1)
+//   1 ·       ╱╲
+//   0 ·──────╱  ╲──────   x
+//     0  1  2  3  4  5  6  7  8
+PolyMesh make_ridge_grid() {
+  PolyMesh mesh = make_grid(8, 3, 8.0, 3.0);
+  for (Vec3& p : mesh.positions) {
+    if (std::abs(p.x() - 4.0) < 1e-9) p.z() = 1.0;
+    p.z() += 0.3 * (p.y() - 1.5) * (p.y() - 1.5);
+  }
+  return mesh;
+}
+
+}  // namespace
+
+// Removing one column of 8: the interior columns away from the ridge (1 and 6) cost nothing but
+// Knodt's in-plane terms; columns at the boundary move a boundary line (heavy edge planes),
+// columns 2–5 bend or flatten the ridge, and rows (or their halves, cut at the ridge) flatten
+// the bend across y. A whole row (16 triangle-equivalents) would leave Eq. 2's band.
+TEST(ShapeSelection, RidgeGridRemovesAFlatInteriorColumn) {
+  const Prepared p = prepare(make_ridge_grid());
+  ShapeSelectionParams params;
+  params.triangle_collapse_factor = 0.0;
+  const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, 42, params);
+  EXPECT_EQ(r.selection.predicted, 42u);
+  EXPECT_EQ(r.stats.segment_collapses, 1);
+  std::set<long> columns;
+  for (Index e = 0; e < p.conn.num_edges; ++e) {
+    if (r.selection.edge_kept[e]) continue;
+    const auto [a, b] = p.conn.edge_vertices[e];
+    const Vec3 &pa = p.mesh.positions[a], &pb = p.mesh.positions[b];
+    ASSERT_NEAR(pa.y(), pb.y(), 1e-9) << "only edges along x collapse when a column goes";
+    columns.insert(std::lround(std::min(pa.x(), pb.x())));
+    EXPECT_GT(std::abs(pa.x() - 4.0), 0.5) << "no collapsed edge touches the ridge";
+    EXPECT_GT(std::abs(pb.x() - 4.0), 0.5) << "no collapsed edge touches the ridge";
+  }
+  ASSERT_EQ(columns.size(), 1u);
+  EXPECT_TRUE(*columns.begin() == 1 || *columns.begin() == 6) << "column " << *columns.begin();
+}
+
+// The greedy's running cost is the sum of exact deltas: it must equal the cost of its final
+// selection computed from scratch (shape_cost applies the collapsed edges one by one).
+TEST(ShapeSelection, IncrementalCostMatchesTheFromScratchOracle) {
+  for (PolyMesh mesh : {make_torus(16, 10, 1.0, 0.3), make_demo_vase(16, 12), make_ridge_grid()}) {
+    const Prepared p = prepare(std::move(mesh));
+    for (double ratio : {0.7, 0.4}) {
+      ShapeSelectionParams params;
+      params.max_triangle_share = 0.3;
+      const std::uint64_t input = tri_equivalent_count(p.mesh);
+      const auto target = static_cast<std::uint64_t>(std::llround(ratio * double(input)));
+      const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, target, params);
+      const ShapeSelectionStats oracle = shape_cost(p.mesh, p.conn, r.selection.edge_kept, params);
+      EXPECT_NEAR(r.stats.error, oracle.error, 1e-9 * std::max(1e-12, oracle.error) + 1e-15) << ratio;
+      EXPECT_NEAR(r.stats.shape, oracle.shape, 1e-9 * std::max(1e-12, oracle.shape) + 1e-15) << ratio;
+      EXPECT_GE(r.stats.error, 0.0);
+      EXPECT_EQ(r.selection.predicted, predicted_tri_equivalent(p.mesh, p.conn, r.selection.edge_kept));
+      EXPECT_EQ(r.stats.reduced_by_segments + r.stats.reduced_by_singles, input - r.selection.predicted);
+    }
+  }
+}
+
+// Nothing collapsed costs nothing; collapsing anything on a curved surface costs something.
+TEST(ShapeSelection, CostOfKnownSelections) {
+  const Prepared p = prepare(make_torus(12, 8, 1.0, 0.3));
+  std::vector<std::uint8_t> kept(p.conn.num_edges, 1);
+  EXPECT_EQ(shape_cost(p.mesh, p.conn, kept).cost, 0.0);
+  kept[0] = 0;
+  EXPECT_GT(shape_cost(p.mesh, p.conn, kept).error, 0.0);
+}
+
+TEST(ShapeSelection, SameInputSameSelection) {
+  const Prepared p = prepare(make_demo_vase(24, 16));
+  const std::uint64_t target = tri_equivalent_count(p.mesh) / 3;
+  const ShapeSelectionResult a = select_by_shape(p.mesh, p.conn, p.analysis, target);
+  const ShapeSelectionResult b = select_by_shape(p.mesh, p.conn, p.analysis, target);
+  EXPECT_EQ(a.selection.edge_kept, b.selection.edge_kept);
+  EXPECT_EQ(a.stats.cost, b.stats.cost);
+}
+
+// Single collapses (they make triangles) are capped at their share of the reduction, and absent
+// when their factor is 0.
+TEST(ShapeSelection, SingleCollapsesStayWithinTheirShare) {
+  const Prepared p = prepare(make_torus(20, 12, 1.0, 0.45));
+  const std::uint64_t input = tri_equivalent_count(p.mesh);
+  const std::uint64_t target = input * 3 / 10;
+  ShapeSelectionParams favoured;
+  favoured.triangle_collapse_factor = 1e-3;  // singles look far cheaper than segments
+  favoured.max_triangle_share = 0.2;
+  const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, target, favoured);
+  EXPECT_GT(r.stats.single_collapses, 0);
+  EXPECT_LE(double(r.stats.reduced_by_singles), 0.2 * double(input - target));
+  EXPECT_TRUE(r.selection.band_enforced);
+
+  ShapeSelectionParams none;
+  none.triangle_collapse_factor = 0.0;
+  const ShapeSelectionResult q = select_by_shape(p.mesh, p.conn, p.analysis, target, none);
+  EXPECT_EQ(q.stats.single_collapses, 0);
+  EXPECT_EQ(q.stats.reduced_by_singles, 0u);
+}
+
+// Pinned edges are never collapsed, neither as part of their segment nor alone.
+TEST(ShapeSelection, PinnedEdgesStay) {
+  const Prepared p = prepare(make_torus(16, 10, 1.0, 0.3));
+  ShapeSelectionParams params;
+  params.keep_edges.assign(p.conn.num_edges, 0);
+  for (Index e = 0; e < p.conn.num_edges; e += 3) params.keep_edges[e] = 1;
+  const ShapeSelectionResult r =
+      select_by_shape(p.mesh, p.conn, p.analysis, tri_equivalent_count(p.mesh) / 2, params);
+  for (Index e = 0; e < p.conn.num_edges; e += 3) EXPECT_TRUE(r.selection.edge_kept[e]) << e;
+}
+
+// The whole pipeline with the shape objective: in the band, valid, and its figures reported.
+TEST(ShapeSelection, PipelineReportsTheShapeObjective) {
+  SimplifyOptions options;
+  options.ratio = 0.4;
+  const PolyMesh vase = make_demo_vase();
+  const SimplifyResult r = simplify(vase, options);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_LE(std::abs(double(r.achieved) - double(r.target)), 0.03 * double(r.target));
+  EXPECT_EQ(r.report["options"]["objective"], "shape");
+  EXPECT_EQ(r.report["selection"]["objective_kind"], "shape");
+  EXPECT_GT(r.report["selection"]["shape"]["segment_collapses"].get<long>(), 0);
+  options.objective = "bogus";
+  EXPECT_FALSE(simplify(vase, options).ok());
+}
