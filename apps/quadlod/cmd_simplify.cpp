@@ -50,6 +50,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--max-triangle-share", p.max_triangle_share,
                   "Largest share of the reduction that single collapses may make")
       ->check(CLI::Range(0.0, 1.0))->default_str(std::to_string(default_max_triangle_share()))->group("Objective");
+  sub->add_option("--shape-flip-angle", p.shape_flip_angle_deg,
+                  "Shape greedy: skip moves that flip a face by more than this angle, degrees (0 = off)")
+      ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Objective");
   sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget in seconds (0 = greedy selection only)")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Solver");
   sub->add_option("--threads", p.threads, "Solver threads: CBC's tree search, and the threads of annealing runs in the fast selection (0 = all cores)")

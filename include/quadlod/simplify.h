@@ -43,6 +43,10 @@ struct SimplifyOptions {
   double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
   double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = default, 0 = none
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
+  /// > 0: the shape greedy drops moves that flip a face by more than this angle against its
+  /// input face or make one degenerate (ShapeSelectionParams::check_faces); 0 = off, the default
+  /// (measured worse: docs/formulation.md, "Shape objective").
+  double shape_flip_angle_deg = 0.0;
 
   // --- solver (objective "paper") --------------------------------------------------------------
   double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only

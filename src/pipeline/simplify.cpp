@@ -379,6 +379,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
             {"reduced_by_singles", shape_stats->reduced_by_singles},
             {"evaluations", shape_stats->evaluations},
             {"overshooting_moves", shape_stats->overshooting_moves},
+            {"invalid_moves", shape_stats->invalid_moves},
         };
       report["dual_repair"] = {
           {"seconds", repaired.seconds},
@@ -496,6 +497,9 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   dp.enable = options.dual_repair;
   ClusterCollapseParams cp;
   shp.placement = cp.placement;  // the cost is priced where the collapse will place
+  if (options.shape_flip_angle_deg > 0.0) shp.flip_angle_deg = options.shape_flip_angle_deg;
+  else shp.check_faces = false;
+  shp.zero_area_epsilon = cp.zero_area_epsilon;
   cp.max_hausdorff = options.max_hausdorff;
   cp.respect_features = options.features;
   cp.project_attributes = options.features;

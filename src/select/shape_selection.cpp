@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <queue>
 #include <span>
@@ -71,6 +72,7 @@ struct Move {
   std::int64_t reduced = 0;  // triangle-equivalents removed (Eq. 1)
   double error = 0.0;        // Δ Σ cluster errors (raw units)
   double shape = 0.0;        // Δ Σ quad-shape penalties (raw units, before λ_shape)
+  bool valid = true;         // no face around the move flips or degenerates
   double cost(double lambda_shape) const { return error + lambda_shape * shape; }
 };
 
@@ -92,12 +94,17 @@ class ShapeState {
     log_aspect0_.assign(nf, 0.0);
     pen_.assign(nf, 0.0);
     double area = 0.0;
+    face_n0_.assign(nf, Vec3::Zero());
     for (Index f = 0; f < nf; ++f) {
       face_kept_[f] = mesh.face_size(f);
-      area += face_area_vector(mesh, f).norm();
+      const Vec3 av = face_area_vector(mesh, f);
+      area += av.norm();
+      if (av.norm() > 0.0) face_n0_[f] = av / av.norm();
       if (mesh.face_size(f) == 4) log_aspect0_[f] = log_aspect(f, [&](Index v) -> const Vec3& { return mesh.positions[v]; });
     }
     const double diag = bounding_box(mesh).diagonal();
+    cos_flip_ = std::cos(std::clamp(params.flip_angle_deg, 1e-6, 180.0) * std::numbers::pi / 180.0);
+    min_area2_ = 2.0 * std::max(0.0, params.zero_area_epsilon) * diag * diag;
     norm_ = (area > 0.0 ? area : 1.0) * (diag > 0.0 ? diag * diag : 1.0);
     for (Index f = 0; f < nf; ++f) count_ += face_count(f, face_kept_[f]);
     root_token_.assign(nv, 0);
@@ -165,8 +172,8 @@ class ShapeState {
     for (Index f : touched_faces_)
       m.reduced += face_count(f, face_kept_[f]) - face_count(f, face_kept_[f] - face_removed_[f]);
 
-    // Quad shapes: every face with a corner in a merged cluster (its corners move).
-    if (params_.lambda_shape > 0.0) {
+    // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
+    {
       ++face_tok2_;
       if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
       shape_faces_.clear();
@@ -182,12 +189,16 @@ class ShapeState {
           });
       for (Index f : shape_faces_) {
         const Index removed = face_token_[f] == token_ ? face_removed_[f] : 0;
-        const double after = penalty(f, face_kept_[f] - removed, [&](Index v) -> const Vec3& {
+        auto placed = [&](Index v) -> const Vec3& {
           const Index r = uf_.find(v);
           if (root_token_[r] == token_) return sets_[set_of_[find_local(root_local_[r])]].placement.position;
           return pos_[r];
-        });
-        m.shape += after - pen_[f];
+        };
+        if (params_.check_faces && face_count(f, face_kept_[f] - removed) > 0 && !faces_like_input(f, placed)) {
+          m.valid = false;
+          return m;
+        }
+        if (params_.lambda_shape > 0.0) m.shape += penalty(f, face_kept_[f] - removed, placed) - pen_[f];
       }
     }
     return m;
@@ -228,6 +239,21 @@ class ShapeState {
   };
 
   static std::int64_t face_count(Index /*f*/, Index kept) { return kept > 2 ? kept - 2 : 0; }
+
+  // The face after the move (its corners at their clusters' positions; corners in one cluster
+  // fall together, which Newell's sum ignores) must face the way its input face did, within
+  // flip_angle_deg, and keep an area: the collapse refuses flipped and degenerate faces
+  // (post/cluster_collapse.h, guarantees), so a move that makes one is never worth its price.
+  template <class PositionOf>
+  bool faces_like_input(Index f, PositionOf&& at) const {
+    const Index b = mesh_.face_begin(f), k = mesh_.face_size(f);
+    const Vec3& o = at(mesh_.corner_vertex[b]);
+    Vec3 av = Vec3::Zero();
+    for (Index i = 1; i + 1 < k; ++i) av += (at(mesh_.corner_vertex[b + i]) - o).cross(at(mesh_.corner_vertex[b + i + 1]) - o);
+    const double len = av.norm();
+    if (!(len > min_area2_)) return false;
+    return face_n0_[f].squaredNorm() == 0.0 || av.dot(face_n0_[f]) > cos_flip_ * len;
+  }
 
   template <class PositionOf>
   double log_aspect(Index f, PositionOf&& at) const {
@@ -298,6 +324,8 @@ class ShapeState {
   std::vector<std::uint8_t> kept_;
   std::vector<Index> face_kept_;
   std::vector<double> log_aspect0_, pen_;
+  std::vector<Vec3> face_n0_;  // unit normal of each input face (zero without area)
+  double cos_flip_ = 0.0, min_area2_ = 0.0;  // twice the smallest area a kept face may have
   std::int64_t count_ = 0;
   double error_ = 0.0, shape_ = 0.0;
 
@@ -376,7 +404,7 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   auto consider = [&](Index id) {
     const Move m = state.evaluate(move_edges(id));
     ++st.evaluations;
-    if (m.reduced > 0) heap.push({priority(id, m), id, version});
+    if (m.reduced > 0 && m.valid) heap.push({priority(id, m), id, version});
   };
   for (Index u = 0; u < nu; ++u)
     if (!units.fixed[u]) consider(u);
@@ -391,6 +419,10 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     const Move m = state.evaluate(move_edges(top.id));
     if (top.version != version) ++st.evaluations;
     if (m.reduced <= 0) continue;
+    if (!m.valid) {
+      ++st.invalid_moves;  // dropped: the faces around it only get more crowded
+      continue;
+    }
     const double p = priority(top.id, m);
     if (top.version != version && !heap.empty() && p > heap.top().priority) {
       heap.push({p, top.id, version});  // stale and now worse than the next: later

@@ -54,6 +54,12 @@ struct ShapeSelectionParams {
   QuadricPlacementParams placement;
   /// λ_shape: weight of the quad-shape term (see above); 0 = geometric error alone.
   double lambda_shape = 0.05;
+  /// Moves that would flip a face beyond this angle against its input face, or leave a kept face
+  /// with less than zero_area_epsilon × diagonal² of area, are not taken: the collapse would
+  /// refuse them (ClusterCollapseParams::flip_angle_deg, zero_area_epsilon; the same values).
+  bool check_faces = true;
+  double flip_angle_deg = 90.0;
+  double zero_area_epsilon = 1e-12;
   /// A single edge collapse (it makes triangles of the quads beside it) competes with segment
   /// collapses at this multiple of its error per triangle-equivalent; 0 disables them.
   double triangle_collapse_factor = 8.0;
@@ -72,6 +78,7 @@ struct ShapeSelectionStats {
   std::uint64_t reduced_by_singles = 0;   ///< … by single collapses
   std::int64_t evaluations = 0;           ///< move evaluations (the greedy's work)
   Index overshooting_moves = 0;           ///< moves dropped: they would leave Eq. 2's band below
+  Index invalid_moves = 0;                ///< moves dropped: a face around them would flip or vanish
 };
 
 struct ShapeSelectionResult {
