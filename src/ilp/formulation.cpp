@@ -1,4 +1,4 @@
-// Global edge selection, paper §3.2 (Eqs. 1–9). See formulation.h for the two formulations and
+// Global edge selection, paper §3.2 (Eqs. 1–9). See select/selection.h for the two formulations and
 // docs/formulation.md for the derivations and the choices where the paper is ambiguous.
 //
 // Face count (Eq. 1). A face f of k corners whose kept edges number S_f becomes a face of S_f
@@ -22,7 +22,7 @@
 // That replaces three rows per quad by three rows per group. Faces of one group are linear,
 // triangles of several groups get an AND variable, and the rest (quads cut by breakpoints on both
 // pairs, n-gons) get the paper's per-face rows.
-#include "ilp/formulation.h"
+#include "select/selection.h"
 
 #include "geometry/quadric.h"
 #include "mesh/union_find.h"

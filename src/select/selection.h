@@ -16,6 +16,10 @@
 //            its start, so a timed-out solve is never worse than greedy and never empty.
 //
 // Either way the result is one bit per input edge: kept (1) or collapsed (0).
+//
+// The stage's interface. The search (groups, greedy, local-search moves, annealing,
+// recombination, select_edges()) is in src/select/, the MIP models and their solves in
+// src/ilp/formulation.{h,cpp} and src/ilp/neighbourhoods.cpp (docs/architecture.md).
 #pragma once
 
 #include "ilp/solver.h"
