@@ -1,5 +1,5 @@
 // Greedy selection (greedy.h): groups collapsed cheapest per removed triangle-equivalent first,
-// inside Eq. 2's band from above and under Eq. 8.
+// never jumping below Eq. 2's band and never breaking Eq. 8.
 #include "select/greedy.h"
 
 #include <cmath>

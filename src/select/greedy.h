@@ -1,5 +1,6 @@
-// The greedy selection of the fast and exact formulations (paper §3.2, Eqs. 1–2 and 8 in group
-// space): the start of every search in src/select/ and of the MIP solves of src/ilp/.
+// The greedy selection (paper §3.2 in group space: N' of Eq. 1 down to the target, Eq. 2's band,
+// Eq. 8), for both formulations: the start of every search in src/select/ and of the MIP solves
+// of src/ilp/.
 #pragma once
 
 #include "select/groups.h"
