@@ -1,5 +1,5 @@
 // The edge-selection ILP (§3.2) against an exhaustive oracle and known answers.
-#include "ilp/formulation.h"
+#include "select/selection.h"
 #include "quadlod/generators.h"
 #include "topology/analysis.h"
 

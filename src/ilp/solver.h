@@ -63,7 +63,7 @@ struct SolveParams {
   /// 12 of 12 runs. A good start (e.g. a previous solution) helps through its cutoff.
   bool start_as_mip_start = true;
   /// Plain branch-and-bound: no cut generation, no primal heuristics, no pre-processing. For
-  /// many small MIPs with a good start (the neighbourhoods of src/ilp/formulation.cpp), where
+  /// many small MIPs with a good start (the neighbourhoods of src/ilp/neighbourhoods.cpp), where
   /// those stages cost more than the search (CBC: ~70 ms per call on a 100-group neighbourhood).
   bool light = false;
   /// Run the backend in a child process (POSIX fork; the CBC backend). A crash inside the solver

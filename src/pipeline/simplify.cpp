@@ -2,12 +2,12 @@
 // result and nothing reaches back. See include/quadlod/simplify.h.
 #include "quadlod/simplify.h"
 
-#include "ilp/formulation.h"
 #include "mesh/connectivity.h"
 #include "mesh/features.h"
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
 #include "post/dual_repair.h"
+#include "select/selection.h"
 #include "select/shape_selection.h"
 #include "topology/analysis.h"
 #include "util/progress.h"

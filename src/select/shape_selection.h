@@ -28,7 +28,7 @@
 #pragma once
 
 #include "geometry/cluster_quadric.h"
-#include "ilp/formulation.h"
+#include "select/selection.h"
 #include "mesh/connectivity.h"
 #include "quadlod/mesh.h"
 #include "topology/analysis.h"
