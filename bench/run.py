@@ -44,6 +44,9 @@ REPO = os.path.dirname(HERE)
 METHODS = {
     "quadlod": ("quadlod", [], "quadlod"),
     "quadlod-greedy": ("quadlod", ["--time-limit", "0"], "quadlod greedy"),
+    # The paper's Eq. 9 (before issue 19's shape objective), greedy and with the default search.
+    "quadlod-paper-greedy": ("quadlod", ["--objective", "paper", "--time-limit", "0"], "Eq. 9 greedy"),
+    "quadlod-paper": ("quadlod", ["--objective", "paper"], "Eq. 9 search"),
     "quadlod-no-consistency": ("quadlod", ["--no-consistency"], "w/o Consist."),
     "quadlod-no-segmentation": ("quadlod", ["--no-segmentation"], "w/o Segmt."),
     "quadlod-no-geometry": ("quadlod", ["--no-geometry"], "w/o Geo."),
@@ -58,7 +61,7 @@ METHODS = {
 ABLATIONS = ["quadlod-no-consistency", "quadlod-no-segmentation", "quadlod-no-geometry",
              "quadlod-no-dual"]
 PEERS = ["single", "single-rel", "meshopt", "meshlab", "blender-collapse", "blender-unsubdiv"]
-TABLE1_METHODS = ["quadlod", "quadlod-greedy"] + PEERS
+TABLE1_METHODS = ["quadlod", "quadlod-greedy", "quadlod-paper-greedy", "quadlod-paper"] + PEERS
 
 # Single (Knodt 2025, the author's simple_qem): an external binary, never linked or vendored
 # (../shared/peers/single/README.md). `single-rel` sets --abs-eps to this fraction of the input's
@@ -577,7 +580,11 @@ class Bench:
                        components_in=info.get("components"))
             kind, extra, _ = METHODS[method]
             if kind == "quadlod":
-                output = self._run_quadlod(mesh_path, ratio, target, extra, base, row, notes)
+                # Every method gets the same clean geometry (positions and polygons, as Single
+                # does) unless --quadlod-input full: with UVs and materials quadlod also keeps
+                # their seams and borders, which no peer is asked to do.
+                src = mesh_path if self.args.quadlod_input == "full" else self.stripped_obj(mesh_path)[0]
+                output = self._run_quadlod(src, ratio, target, extra, base, row, notes)
             elif kind == "meshopt":
                 output = self._run_meshopt(mesh_path, target, base, row)
             elif kind == "meshlab":
@@ -1434,6 +1441,9 @@ def parse_args(argv):
     p.add_argument("--build-peers", action="store_true",
                    help="configure build-bench/ and build quadlod_meshopt_peer first")
     p.add_argument("--blender", default="blender", help="Blender executable")
+    p.add_argument("--quadlod-input", choices=["clean", "full"], default="clean",
+                   help="what quadlod reads: clean = the positions-and-polygons OBJ Single gets "
+                        "(default), full = the corpus file with UVs, normals and materials")
     p.add_argument("--single", default=None,
                    help="Single (Knodt 2025) decimate binary (default $QUADLOD_SINGLE, else "
                         "../shared/peers/single/decimate)")

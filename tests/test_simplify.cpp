@@ -51,6 +51,7 @@ SimplifyOptions quick(double ratio) {
 SimplifyOptions quick_paper(double ratio) {
   SimplifyOptions o = quick(ratio);
   o.objective = "paper";
+  o.place_on_hard_edges = true;
   return o;
 }
 
@@ -316,6 +317,7 @@ TEST(SimplifyCorpus, IslandsAreNotCutAtSidesWithMoreThanTwoFaces) {
 // 0.1 the greedy run on suzanne at 0.2 lands on 194 and nothing falls back).
 SimplifyOptions with_old_lambdas(SimplifyOptions o) {
   o.objective = "paper";
+  o.place_on_hard_edges = true;
   o.lambda_geo = 4.0;
   o.lambda_edge = 0.05;
   return o;

@@ -96,6 +96,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
+  sub->add_flag("--place-on-hard-edges", p.place_on_hard_edges,
+                "Keep merged vertices on hard edges (else they follow their quadric, which weighs sharp edges heavily)")
+      ->group("Features");
   sub->add_option("--hard-angle", p.hard_angle_deg, "Dihedral angle (degrees) from which an edge is a hard edge")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Features");
   sub->add_flag("--no-consistency", opt->no_consistency, "Ablation: drop Eq. 4")->group("Ablations");

@@ -98,6 +98,9 @@ struct SimplifyOptions {
   bool features = true;
   /// Dihedral angle (degrees) from which a manifold edge is a hard edge (default ϵ_θ).
   double hard_angle_deg = 60.0;
+  /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7
+  /// did; false = by their quadric (ClusterCollapseParams::place_on_hard_edges, measured).
+  bool place_on_hard_edges = false;
 
   // --- guarantees -------------------------------------------------------------------------------
   /// Bound on the distance of moved vertices from the input, relative to the bounding-box

@@ -504,6 +504,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
   cp.features.hard_angle_deg = options.hard_angle_deg;
+  cp.place_on_hard_edges = options.place_on_hard_edges;
   // Islands big enough for one output face must keep one (issue 7): the smallest area an output
   // face can have on average, the input's area over the target's tri-equivalents.
   {
@@ -708,6 +709,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"max_hausdorff", options.max_hausdorff},
       {"features", options.features},
       {"hard_angle_deg", options.hard_angle_deg},
+      {"place_on_hard_edges", options.place_on_hard_edges},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},

@@ -463,8 +463,13 @@ void Collapser::place(Index r) {
 bool Collapser::place_on_feature(Index r, const Quadric& q) {
   Index corners = 0, corner = kInvalidIndex;
   bool strict = false, any = false;
+  // Vertices whose only feature is a hard edge follow their quadric unless place_on_hard_edges.
+  auto counts = [&](Index m) {
+    return feat_ptr_->on_feature(m) &&
+           (params_.place_on_hard_edges || (feat_ptr_->vertex_bits[m] & ~std::uint32_t(kFeatureHardEdge)) != 0);
+  };
   for (Index m : members(r)) {
-    if (!feat_ptr_->on_feature(m)) continue;
+    if (!counts(m)) continue;
     any = true;
     strict = strict || feat_ptr_->on_strict(m);
     if (feat_ptr_->vertex_corner[m]) {

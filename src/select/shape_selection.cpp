@@ -382,12 +382,9 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
 
   // A single collapse is a candidate where it differs from its unit's collapse.
   auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.edge_unit[e]).size() > 1; };
-  auto edges_of = [&](Index id) -> std::span<const Index> {
-    return id < nu ? units.of(id) : std::span<const Index>(&units.edges[0], 0);
-  };
   Index single_scratch = 0;
   auto move_edges = [&](Index id) -> std::span<const Index> {
-    if (id < nu) return edges_of(id);
+    if (id < nu) return units.of(id);
     single_scratch = id - nu;
     return {&single_scratch, 1};
   };

@@ -53,7 +53,7 @@ struct ShapeSelectionParams {
   /// at the same positions.
   QuadricPlacementParams placement;
   /// λ_shape: weight of the quad-shape term (see above); 0 = geometric error alone.
-  double lambda_shape = 0.05;
+  double lambda_shape = 0.0;
   /// Moves that would flip a face beyond this angle against its input face, or leave a kept face
   /// with less than zero_area_epsilon × diagonal² of area, are not taken: the collapse would
   /// refuse them (ClusterCollapseParams::flip_angle_deg, zero_area_epsilon; the same values).
@@ -62,10 +62,10 @@ struct ShapeSelectionParams {
   double zero_area_epsilon = 1e-12;
   /// A single edge collapse (it makes triangles of the quads beside it) competes with segment
   /// collapses at this multiple of its error per triangle-equivalent; 0 disables them.
-  double triangle_collapse_factor = 8.0;
+  double triangle_collapse_factor = 3.0;
   /// At most this share of the reduction (input − N triangle-equivalents) comes from single
   /// collapses.
-  double max_triangle_share = 0.25;
+  double max_triangle_share = 0.4;
 };
 
 struct ShapeSelectionStats {
