@@ -3,13 +3,20 @@
 #include "select/shape_selection.h"
 
 #include "quadlod/generators.h"
+#include "quadlod/io.h"
 #include "quadlod/simplify.h"
 #include "topology/analysis.h"
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
+#include <string>
 
 using namespace quadlod;
 
@@ -157,4 +164,28 @@ TEST(ShapeSelection, PipelineReportsTheShapeObjective) {
   EXPECT_GT(r.report["selection"]["shape"]["segment_collapses"].get<long>(), 0);
   options.objective = "bogus";
   EXPECT_FALSE(simplify(vase, options).ok());
+}
+
+// Issue 20's first requirement for the default objective: the same input and options give the
+// same output file, whatever the thread count (the shape greedy has no clock and no threads).
+TEST(ShapeSelection, OutputBytesDoNotDependOnThreads) {
+  const PolyMesh vase = make_demo_vase();
+  auto bytes = [&](int threads) {
+    SimplifyOptions options;
+    options.ratio = 0.3;
+    options.threads = threads;
+    const SimplifyResult r = simplify(vase, options);
+    EXPECT_TRUE(r.ok()) << r.error;
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("quadlod_shape_threads_" + std::to_string(threads) + "_" + std::to_string(::getpid()) + ".obj");
+    EXPECT_TRUE(write_mesh(r.mesh, path.string()).ok());
+    std::ifstream in(path, std::ios::binary);
+    std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::filesystem::remove(path);
+    return data;
+  };
+  const std::string one = bytes(1);
+  EXPECT_FALSE(one.empty());
+  EXPECT_EQ(one, bytes(2));
+  EXPECT_EQ(one, bytes(1));
 }

@@ -34,7 +34,7 @@ struct SimplifyOptions {
   /// < 0 = the measured default, 0 = the paper's objective.
   double lambda_tri = -1.0;
 
-  // --- objective (issue "Shape first"; docs/formulation.md, "Shape objective") ----------------
+  // --- objective (issue "Shape first"; docs/shape_objective.md) ----------------
   /// "shape" (default): the selection minimises the geometric error of the mesh it produces
   /// (cluster quadrics at the collapse's placement, plus the quad-shape term), by a deterministic
   /// greedy (src/select/shape_selection.h). "paper": Eq. 9 with the MIP / annealing search
@@ -45,7 +45,7 @@ struct SimplifyOptions {
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
   /// > 0: the shape greedy drops moves that flip a face by more than this angle against its
   /// input face or make one degenerate (ShapeSelectionParams::check_faces); 0 = off, the default
-  /// (measured worse: docs/formulation.md, "Shape objective").
+  /// (measured worse: docs/shape_objective.md).
   double shape_flip_angle_deg = 0.0;
 
   // --- solver (objective "paper") --------------------------------------------------------------
@@ -136,7 +136,7 @@ double default_lambda_geo();
 double default_stall_seconds();
 double default_lambda_edge();
 double default_lambda_tri();
-/// The measured defaults of the shape objective (docs/parameters.md, "Shape objective").
+/// The measured defaults of the shape objective (docs/shape_objective.md).
 double default_lambda_shape();
 double default_triangle_collapse_factor();
 double default_max_triangle_share();

@@ -79,8 +79,8 @@ struct ClusterCollapseParams {
   /// on no other feature are placed on the hard line or at its corner (issue 7's rule) when true;
   /// when false they follow their quadric, whose edge planes weigh sharp edges like boundaries
   /// (QuadricPlacementParams::feature_edge_weight). false by measurement (issue 19,
-  /// docs/formulation.md "Shape objective": on 12 corpus meshes at 0.4 the pinned placement cost
-  /// 15 % more Chamfer than Single's against 4 % less without it). Hard edges still separate the
+  /// docs/shape_objective.md: on 12 corpus meshes at 0.4 the pinned placement cost
+  /// 11 % more Chamfer than Single's against 4 % less without it). Hard edges still separate the
   /// normal sectors of the output either way.
   bool place_on_hard_edges = false;
 
