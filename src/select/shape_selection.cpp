@@ -14,6 +14,7 @@
 #include "select/shape_selection.h"
 
 #include "mesh/union_find.h"
+#include "select/groups.h"
 
 #include <algorithm>
 #include <cmath>
@@ -26,33 +27,24 @@ namespace quadlod {
 
 namespace {
 
-// Decision units: the opposing edges of a segment (joined through shared non-manifold edges),
-// every other edge on its own — the groups of the fast formulation.
+// Decision units: the groups of the fast formulation (select/groups.h) — the opposing edges of
+// a segment joined through shared non-manifold edges, every other edge on its own — with the
+// groups that hold a pinned edge fixed.
 struct Units {
-  Index count = 0;
-  std::vector<Index> edge_unit, offsets, edges;
-  std::vector<std::uint8_t> fixed;  // 1: never collapsed as a unit
-  std::span<const Index> of(Index u) const { return {edges.data() + offsets[u], std::size_t(offsets[u + 1] - offsets[u])}; }
+  select_detail::Groups g;
+  Index count() const { return g.count; }
+  std::span<const Index> of(Index u) const {
+    return {g.edges.data() + g.offsets[u], std::size_t(g.offsets[u + 1] - g.offsets[u])};
+  }
 };
 
 Units make_units(const Connectivity& conn, const AnalysisResult& analysis, const ShapeSelectionParams& params,
                  const std::vector<std::uint8_t>& pinned) {
-  UnionFind uf(conn.num_edges);
-  if (params.consistency)
-    for (const Segment& s : analysis.segmentation.segments)
-      for (std::size_t i = 1; i < s.opposing_edges.size(); ++i) uf.unite(s.opposing_edges[0], s.opposing_edges[i]);
-  Units u;
-  u.edge_unit = uf.dense_labels(u.count);
-  u.offsets.assign(std::size_t(u.count) + 1, 0);
-  for (Index e = 0; e < conn.num_edges; ++e) ++u.offsets[u.edge_unit[e] + 1];
-  std::partial_sum(u.offsets.begin(), u.offsets.end(), u.offsets.begin());
-  u.edges.resize(conn.num_edges);
-  std::vector<Index> fill(u.offsets.begin(), u.offsets.end() - 1);
-  for (Index e = 0; e < conn.num_edges; ++e) u.edges[fill[u.edge_unit[e]]++] = e;
-  u.fixed.assign(u.count, 0);
-  for (Index e = 0; e < conn.num_edges; ++e)
-    if (pinned[e]) u.fixed[u.edge_unit[e]] = 1;
-  return u;
+  SelectionParams grouping;
+  grouping.consistency = params.consistency;
+  grouping.keep_nonmanifold_edges = false;  // already in `pinned`
+  grouping.keep_edges = pinned;
+  return {select_detail::make_groups(conn, analysis, std::vector<double>(conn.num_edges, 0.0), grouping)};
 }
 
 // Pinned edges: the caller's keep list and (optionally) non-manifold edges.
@@ -378,10 +370,10 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   const bool singles = params.consistency && single_factor > 0.0 && params.max_triangle_share > 0.0;
   const std::int64_t single_budget =
       singles ? std::int64_t(params.max_triangle_share * double(sel.input_tri_equivalent - target)) : 0;
-  const Index nu = units.count;
+  const Index nu = units.count();
 
   // A single collapse is a candidate where it differs from its unit's collapse.
-  auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.edge_unit[e]).size() > 1; };
+  auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.g.edge_group[e]).size() > 1; };
   Index single_scratch = 0;
   auto move_edges = [&](Index id) -> std::span<const Index> {
     if (id < nu) return units.of(id);
@@ -404,7 +396,7 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     if (m.reduced > 0 && m.valid) heap.push({priority(id, m), id, version});
   };
   for (Index u = 0; u < nu; ++u)
-    if (!units.fixed[u]) consider(u);
+    if (!units.g.fixed[u]) consider(u);
   if (singles)
     for (Index e = 0; e < conn.num_edges; ++e)
       if (single_edge(e)) consider(nu + e);
