@@ -162,6 +162,9 @@ TEST(ShapeSelection, PipelineReportsTheShapeObjective) {
   EXPECT_EQ(r.report["options"]["objective"], "shape");
   EXPECT_EQ(r.report["selection"]["objective_kind"], "shape");
   EXPECT_GT(r.report["selection"]["shape"]["segment_collapses"].get<long>(), 0);
+  // The shape objective's passes: 0.4 at a pass ratio of 0.9 plans ⌈log 0.4 / log 0.9⌉ = 9.
+  EXPECT_EQ(r.report["passes_planned"].get<int>(), 9);
+  EXPECT_EQ(r.report["options"]["pass_ratio"].get<double>(), 0.9);
   options.objective = "bogus";
   EXPECT_FALSE(simplify(vase, options).ok());
 }

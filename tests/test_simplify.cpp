@@ -157,7 +157,7 @@ TEST(Simplify, RoundsPinRefusedCollapsesAndReAim) {
 TEST(Simplify, LargeReductionsRunInPassesOfEqualRatio) {
   // 0.2 with pass_ratio 0.5: k = ⌈log 0.2 / log 0.5⌉ = 3 planned passes aiming at N0·0.2^(i/3).
   const PolyMesh torus = make_torus(32, 20);
-  const SimplifyResult r = simplify(torus, quick(0.2));
+  const SimplifyResult r = simplify(torus, quick_paper(0.2));
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_EQ(r.report["passes_planned"].get<int>(), 3);
   const auto& passes = r.report["passes"];

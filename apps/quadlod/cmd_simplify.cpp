@@ -87,9 +87,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1, 64))->capture_default_str()->group("Guarantees");
   sub->add_option("--pass-ratio", p.pass_ratio,
                   "Split reductions below this ratio into passes of equal ratio, each at most this")
-      ->check(CLI::Range(0.05, 0.95))->capture_default_str()->group("Guarantees");
+      ->check(CLI::Range(0.05, 0.95))
+      ->default_str(std::to_string(default_pass_ratio("shape")) + " (shape), " + std::to_string(default_pass_ratio("paper")) + " (paper)")
+      ->group("Guarantees");
   sub->add_option("--max-passes", p.max_passes, "Most passes (1 = one global selection, as in the paper)")
-      ->check(CLI::Range(1, 32))->capture_default_str()->group("Guarantees");
+      ->check(CLI::Range(1, 64))
+      ->default_str(std::to_string(default_max_passes("shape")) + " (shape), " + std::to_string(default_max_passes("paper")) + " (paper)")
+      ->group("Guarantees");
   sub->add_flag("--no-greedy-fallback", opt->no_greedy_fallback,
                 "Keep the optimised selection's output even when a greedy selection's run gets closer to the target")
       ->group("Guarantees");

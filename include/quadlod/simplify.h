@@ -74,11 +74,14 @@ struct SimplifyOptions {
   // --- passes (beyond the paper) ------------------------------------------------------------
   /// A reduction below this ratio is split into passes of equal ratio, each at most this, each
   /// one run of the whole pipeline on the previous pass's output (src/pipeline/simplify.cpp);
-  /// `time_limit_seconds` is shared among the planned passes. In (0, 1).
-  double pass_ratio = 0.5;
+  /// `time_limit_seconds` is shared among the planned passes. In (0, 1); < 0 = the objective's
+  /// measured default: 0.9 for `shape` (docs/shape_objective.md, "Passes"), 0.5 for `paper`
+  /// (docs/formulation.md, "Passes").
+  double pass_ratio = -1.0;
   /// Most passes, the planned ones and extra ones that aim at N after a miss. 1 = one pass, the
-  /// paper's single global selection.
-  int max_passes = 6;
+  /// paper's single global selection. < 0 = the objective's default: 32 for `shape` (0.2 at a
+  /// pass ratio of 0.9 plans 16), 6 for `paper`.
+  int max_passes = -1;
   /// When the output misses Eq. 2's band, run the pipeline again with the greedy selection and
   /// keep the output closer to the target (report: `fallback`). Beyond the paper; off in
   /// measurements of the selection itself (bench/selection_quality).
@@ -140,5 +143,8 @@ double default_lambda_tri();
 double default_lambda_shape();
 double default_triangle_collapse_factor();
 double default_max_triangle_share();
+/// The pass ratio and pass count an objective ("shape" or "paper") uses when none is given.
+double default_pass_ratio(const std::string& objective);
+int default_max_passes(const std::string& objective);
 
 }  // namespace quadlod
