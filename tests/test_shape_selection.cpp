@@ -192,3 +192,29 @@ TEST(ShapeSelection, OutputBytesDoNotDependOnThreads) {
   EXPECT_EQ(one, bytes(2));
   EXPECT_EQ(one, bytes(1));
 }
+
+// The exchanges after the greedy only take moves that lower the cost and keep N' in the band,
+// and their undo / redo keeps the incremental cost exact (against the from-scratch oracle).
+TEST(ShapeSelection, ExchangesNeverRaiseTheCost) {
+  for (PolyMesh mesh : {make_torus(16, 10, 1.0, 0.3), make_demo_vase(16, 12), make_ridge_grid()}) {
+    const Prepared p = prepare(std::move(mesh));
+    const std::uint64_t input = tri_equivalent_count(p.mesh);
+    for (double ratio : {0.7, 0.4}) {
+      const auto target = static_cast<std::uint64_t>(std::llround(ratio * double(input)));
+      ShapeSelectionParams params;
+      params.swap_rounds = 3;
+      const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, target, params);
+      EXPECT_LE(r.stats.cost, r.stats.greedy_cost * (1.0 + 1e-9) + 1e-15) << ratio;
+      EXPECT_GT(r.stats.swaps_tried, 0);
+      if (r.selection.band_enforced) {
+        EXPECT_GE(double(r.selection.predicted), 0.97 * double(target) - 1.0);
+        EXPECT_LE(double(r.selection.predicted), 1.03 * double(target) + 1.0);
+      }
+      const ShapeSelectionStats oracle = shape_cost(p.mesh, p.conn, r.selection.edge_kept, params);
+      EXPECT_NEAR(r.stats.error, oracle.error, 1e-8 * std::max(1e-12, oracle.error) + 1e-15) << ratio;
+      EXPECT_EQ(r.selection.predicted, predicted_tri_equivalent(p.mesh, p.conn, r.selection.edge_kept));
+      EXPECT_EQ(r.stats.reduced_by_segments + r.stats.reduced_by_singles, input - r.selection.predicted);
+      EXPECT_LE(double(r.stats.reduced_by_singles), params.max_triangle_share * double(input - target) + 1e-9);
+    }
+  }
+}

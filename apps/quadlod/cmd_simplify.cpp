@@ -50,6 +50,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--max-triangle-share", p.max_triangle_share,
                   "Largest share of the reduction that single collapses may make")
       ->check(CLI::Range(0.0, 1.0))->default_str(std::to_string(default_max_triangle_share()))->group("Objective");
+  sub->add_option("--swap-rounds", p.swap_rounds,
+                  "Exchange rounds after the shape greedy: undo a collapsed move, take a cheaper one (0 = greedy alone)")
+      ->check(CLI::Range(0, 64))->default_str(std::to_string(default_swap_rounds()))->group("Objective");
   sub->add_option("--shape-flip-angle", p.shape_flip_angle_deg,
                   "Shape greedy: skip moves that flip a face by more than this angle, degrees (0 = off)")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Objective");

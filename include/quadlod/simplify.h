@@ -43,6 +43,7 @@ struct SimplifyOptions {
   double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
   double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = default, 0 = none
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
+  int swap_rounds = -1;                    ///< exchange rounds after the shape greedy; < 0 = default
   /// > 0: the shape greedy drops moves that flip a face by more than this angle against its
   /// input face or make one degenerate (ShapeSelectionParams::check_faces); 0 = off, the default
   /// (measured worse: docs/shape_objective.md).
@@ -143,6 +144,7 @@ double default_lambda_tri();
 double default_lambda_shape();
 double default_triangle_collapse_factor();
 double default_max_triangle_share();
+int default_swap_rounds();
 /// The pass ratio and pass count an objective ("shape" or "paper") uses when none is given.
 double default_pass_ratio(const std::string& objective);
 int default_max_passes(const std::string& objective);

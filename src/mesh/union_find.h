@@ -45,6 +45,12 @@ class UnionFind {
     return label;
   }
   Index size() const { return static_cast<Index>(parent_.size()); }
+  /// Makes x a singleton again. Only valid when every member of x's set is reset in the same
+  /// sweep (no other element may still point at one of them): how a set is split and rebuilt.
+  void reset(Index x) {
+    parent_[x] = x;
+    size_[x] = 1;
+  }
 
  private:
   std::vector<Index> parent_;

@@ -34,6 +34,7 @@ double default_lambda_tri() { return selection_defaults().lambda_tri; }
 double default_lambda_shape() { return ShapeSelectionParams{}.lambda_shape; }
 double default_triangle_collapse_factor() { return ShapeSelectionParams{}.triangle_collapse_factor; }
 double default_max_triangle_share() { return ShapeSelectionParams{}.max_triangle_share; }
+int default_swap_rounds() { return ShapeSelectionParams{}.swap_rounds; }
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
 // ratios 0.5 / 0.7 / 0.85 / 0.9 / 0.95 gave Chamfer 0.98 / 0.96 / 0.90 / 0.88 / 0.85 of Single's
 // at 0.4 and 1.12 / 1.06 / 0.98 / 0.95 / 0.94 at 0.2, at 1.0 / 1.1 / 1.5 / 1.8 / 3.1 s in all.
@@ -64,19 +65,36 @@ std::vector<std::uint8_t> feature_pins(const Connectivity& conn, const FeatureEd
   return pins;
 }
 
-// One line per finished stage: "[3/5] select      1.84 s  (total 2.10 s)".
+// Progress on stderr: one line per finished stage, "[2/5] select  37%  0.01 s  (elapsed
+// 0.41 s)  …". The percentage is the work done — triangle-equivalents removed so far of those the
+// whole reduction removes (issue 20: work, not the time budget); the pipeline sets it after every
+// collapse. A reduction in many passes would print dozens of lines a second, so a line is only
+// printed once at least `min_gap` seconds passed since the last one (the final line always is).
 class StageLog {
  public:
-  explicit StageLog(bool enabled) : enabled_(enabled) {}
+  explicit StageLog(bool enabled, double min_gap = 0.25) : enabled_(enabled), min_gap_(min_gap) {}
+  /// The reduction runs from `from` to `to` triangle-equivalents; `now` is where it stands.
+  void set_span(double from, double to) {
+    from_ = from;
+    to_ = to;
+  }
+  void set_count(double now) { work_ = from_ > to_ ? std::clamp((from_ - now) / (from_ - to_), 0.0, 1.0) : 1.0; }
   void done(int index, const char* stage, double seconds, const std::string& detail = {}) {
     if (!enabled_) return;
+    const double now = total_.seconds();
+    if (index < 5 && printed_ && now - last_ < min_gap_) return;
+    printed_ = true;
+    last_ = now;
     std::fprintf(stderr, "[%d/5] %-9s %3d%%  %7.2f s  (elapsed %.2f s)%s%s\n", index, stage,
-                 index * 100 / 5, seconds, total_.seconds(), detail.empty() ? "" : "  ",
+                 index == 5 ? 100 : int(work_ * 100.0), seconds, now, detail.empty() ? "" : "  ",
                  detail.c_str());
   }
 
  private:
   bool enabled_;
+  double min_gap_;
+  double work_ = 0.0, last_ = 0.0, from_ = 0.0, to_ = 0.0;
+  bool printed_ = false;
   Stopwatch total_;
 };
 
@@ -320,6 +338,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     out.seconds_collapse += clock.seconds();
     const std::int64_t achieved = static_cast<std::int64_t>(collapsed.stats.tri_equivalent_out);
     const std::int64_t drift = achieved - static_cast<std::int64_t>(target);
+    log.set_count(double(achieved));
     log.done(4, "collapse", clock.seconds(),
              std::to_string(collapsed.stats.total_refusals()) + " clusters refused, " +
                  std::to_string(achieved) + " of " + std::to_string(target) + tag);
@@ -385,6 +404,9 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
             {"evaluations", shape_stats->evaluations},
             {"overshooting_moves", shape_stats->overshooting_moves},
             {"invalid_moves", shape_stats->invalid_moves},
+            {"greedy_cost", shape_stats->greedy_cost},
+            {"swaps_tried", shape_stats->swaps_tried},
+            {"swaps_taken", shape_stats->swaps_taken},
         };
       report["dual_repair"] = {
           {"seconds", repaired.seconds},
@@ -469,6 +491,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   result.target = options.target_tri_equivalent > 0
                       ? options.target_tri_equivalent
                       : static_cast<std::uint64_t>(std::llround(options.ratio * double(result.input_tri_equivalent)));
+  log.set_span(double(result.input_tri_equivalent), double(result.target));
   SelectionParams sp;
   sp.epsilon_n = options.epsilon_n;
   if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
@@ -499,6 +522,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   if (options.lambda_shape >= 0.0) shp.lambda_shape = options.lambda_shape;
   if (options.triangle_collapse_factor >= 0.0) shp.triangle_collapse_factor = options.triangle_collapse_factor;
   if (options.max_triangle_share >= 0.0) shp.max_triangle_share = options.max_triangle_share;
+  if (options.swap_rounds >= 0) shp.swap_rounds = options.swap_rounds;
   DualRepairParams dp;
   dp.enable = options.dual_repair;
   ClusterCollapseParams cp;
@@ -726,6 +750,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"lambda_shape", shp.lambda_shape},
       {"triangle_collapse_factor", shp.triangle_collapse_factor},
       {"max_triangle_share", shp.max_triangle_share},
+      {"swap_rounds", shp.swap_rounds},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +

@@ -77,6 +77,7 @@ class ShapeState {
     h_ = vq.mean_edge;
     terms_.resize(nv);
     for (Index v = 0; v < nv; ++v) terms_[v].add_vertex(vq.terms[v], mesh.positions[v]);
+    base_terms_ = terms_;
     err_.assign(nv, 0.0);  // a lone vertex sits on all of its planes
     pos_ = mesh.positions;
     next_member_.resize(nv);
@@ -196,6 +197,92 @@ class ShapeState {
     return m;
   }
 
+  // Undoes the collapse of the collapsed edges among `edges`: the clusters they are in are split
+  // and rebuilt from the collapsed edges left, placed again, and the faces around them priced
+  // again. Returns the change (reduced < 0: the count grows).
+  Move uncollapse(std::span<const Index> edges) {
+    Move m;
+    ++token_;
+    split_roots_.clear();
+    split_members_.clear();
+    for (Index e : edges) {
+      if (kept_[e]) continue;
+      kept_[e] = 1;
+      for (Index c : conn_.corners_of_edge(e)) {
+        const Index f = conn_.corner_face[c];
+        const std::int64_t before = face_count(f, face_kept_[f]);
+        ++face_kept_[f];
+        m.reduced -= face_count(f, face_kept_[f]) - before;
+      }
+      for (Index v : conn_.edge_vertices[e]) {
+        const Index r = uf_.find(v);
+        if (root_token_[r] == token_) continue;
+        root_token_[r] = token_;
+        split_roots_.push_back(r);
+      }
+    }
+    if (split_roots_.empty()) return m;
+    count_ -= m.reduced;
+    for (Index r : split_roots_) {
+      m.error -= err_[r];
+      for_each_member(r, [&](Index v) { split_members_.push_back(v); });
+    }
+    ++face_tok2_;
+    if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
+    shape_faces_.clear();
+    for (Index v : split_members_)
+      for (Index c : conn_.corners_at_vertex(v)) {
+        const Index f = conn_.corner_face[c];
+        if (face_token2_[f] == face_tok2_) continue;
+        face_token2_[f] = face_tok2_;
+        shape_faces_.push_back(f);
+      }
+    for (Index v : split_members_) {
+      uf_.reset(v);
+      next_member_[v] = v;
+      terms_[v] = base_terms_[v];
+      err_[v] = 0.0;
+      pos_[v] = mesh_.positions[v];
+    }
+    // Rebuild along the collapsed edges left (they join members only: a collapsed edge lies
+    // inside one cluster).
+    for (Index v : split_members_)
+      for (Index c : conn_.corners_at_vertex(v))
+        for (Index e : {conn_.corner_edge[c], conn_.corner_edge[conn_.corner_prev[c]]}) {
+          if (kept_[e]) continue;
+          const auto [a, b] = conn_.edge_vertices[e];
+          const Index ra = uf_.find(a), rb = uf_.find(b);
+          if (ra == rb) continue;
+          ClusterTerms t = terms_[ra];
+          t += terms_[rb];
+          std::swap(next_member_[ra], next_member_[rb]);
+          const Index r = uf_.unite(ra, rb);
+          terms_[r] = t;
+        }
+    ++token_;
+    for (Index v : split_members_) {
+      const Index r = uf_.find(v);
+      if (root_token_[r] == token_) continue;
+      root_token_[r] = token_;
+      if (next_member_[r] == r) continue;  // a lone vertex: at its place, no error
+      const ClusterPlacement pl = place_cluster(terms_[r], h_, params_.placement, [&](auto&& visit) {
+        for_each_member(r, [&](Index w) { visit(mesh_.positions[w]); });
+      });
+      err_[r] = pl.error;
+      pos_[r] = pl.position;
+      m.error += pl.error;
+    }
+    error_ += m.error;
+    if (params_.lambda_shape > 0.0)
+      for (Index f : shape_faces_) {
+        const double p = penalty(f, face_kept_[f], [&](Index v) -> const Vec3& { return pos_[uf_.find(v)]; });
+        m.shape += p - pen_[f];
+        shape_ += p - pen_[f];
+        pen_[f] = p;
+      }
+    return m;
+  }
+
   // Applies the move last priced by evaluate().
   void apply(const Move& m) {
     for (Index e : moved_edges_) kept_[e] = 0;
@@ -310,6 +397,7 @@ class ShapeState {
   UnionFind uf_;
   double h_ = 1.0, norm_ = 1.0;
   std::vector<ClusterTerms> terms_;  // per root
+  std::vector<ClusterTerms> base_terms_;  // per vertex alone
   std::vector<double> err_;          // per root
   std::vector<Vec3> pos_;            // per root
   std::vector<Index> next_member_;
@@ -325,6 +413,7 @@ class ShapeState {
   Index token_ = 0, face_tok2_ = 0;
   std::vector<Index> root_token_, root_local_, face_token_, face_removed_, face_token2_;
   std::vector<Index> locals_, local_parent_, set_of_, moved_edges_, touched_faces_, shape_faces_;
+  std::vector<Index> split_roots_, split_members_;
   std::vector<NewCluster> sets_;
 };
 
@@ -433,9 +522,92 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     }
   }
 
-  sel.edge_kept = state.edge_kept();
-  sel.predicted = sel.greedy_predicted = std::uint64_t(state.count());
   const std::int64_t band_hi = std::int64_t(std::floor((1.0 + params.epsilon_n) * double(target) + 1e-9));
+  st.greedy_cost = (state.error() + params.lambda_shape * state.shape()) / state.normalisation();
+  sel.greedy_predicted = std::uint64_t(state.count());
+
+  // Exchanges (item 4, "search that pays"): the greedy priced each move when it took it, but
+  // later moves beside it grow its clusters, so its price now may exceed what a move it passed
+  // over would cost. Each round undoes every collapsed move in turn (by id) and collapses instead
+  // the best of the `swap_candidates` cheapest moves left, when that lowers the cost and keeps
+  // N' in Eq. 2's band; otherwise the move is redone. Work is counted in moves, not seconds.
+  if (params.swap_rounds > 0 && state.count() >= lo && state.count() <= band_hi) {
+    std::vector<Index> taken;  // collapsed moves: units wholly collapsed, and single edges
+    for (int round = 0; round < params.swap_rounds; ++round) {
+      taken.clear();
+      std::vector<std::uint8_t> whole(nu, 0);
+      for (Index u = 0; u < nu; ++u) {
+        bool all = !units.g.fixed[u];
+        for (Index e : units.of(u)) all = all && !state.kept(e);
+        whole[u] = all;
+        if (all) taken.push_back(u);
+      }
+      if (singles)
+        for (Index e = 0; e < conn.num_edges; ++e)
+          if (single_edge(e) && !state.kept(e) && !whole[units.g.edge_group[e]]) taken.push_back(nu + e);
+      // The cheapest moves left, priced now.
+      std::vector<Candidate> left;
+      for (Index u = 0; u < nu; ++u) {
+        if (units.g.fixed[u]) continue;
+        const Move m = state.evaluate(units.of(u));
+        ++st.evaluations;
+        if (m.reduced > 0 && m.valid) left.push_back({priority(u, m), u, 0});
+      }
+      if (singles)
+        for (Index e = 0; e < conn.num_edges; ++e)
+          if (single_edge(e) && state.kept(e)) {
+            const Move m = state.evaluate(move_edges(nu + e));
+            ++st.evaluations;
+            if (m.reduced > 0 && m.valid) left.push_back({priority(nu + e, m), nu + e, 0});
+          }
+      const std::size_t k = std::min<std::size_t>(left.size(), std::size_t(std::max(0, params.swap_candidates)));
+      std::partial_sort(left.begin(), left.begin() + k, left.end(),
+                        [](const Candidate& a, const Candidate& b) { return b < a; });
+      left.resize(k);
+      Index gained = 0;
+      for (Index a : taken) {
+        const Move undo = state.uncollapse(move_edges(a));
+        ++st.swaps_tried;
+        const std::uint64_t refund = a >= nu ? std::uint64_t(-undo.reduced) : 0;
+        double best = 0.0;
+        Index best_id = kInvalidIndex;
+        for (const Candidate& c : left) {
+          if (c.id == a) continue;
+          const Move m = state.evaluate(move_edges(c.id));
+          ++st.evaluations;
+          if (!m.valid || m.reduced <= 0) continue;
+          const std::int64_t n = state.count() - m.reduced;
+          if (n < lo || n > band_hi) continue;
+          if (c.id >= nu && st.reduced_by_singles - refund + std::uint64_t(m.reduced) > std::uint64_t(single_budget))
+            continue;
+          const double total = undo.cost(params.lambda_shape) + m.cost(params.lambda_shape);
+          if (total < best) {
+            best = total;
+            best_id = c.id;
+          }
+        }
+        // Only a gain beyond rounding counts (undo + redo of the same clusters is not exact).
+        if (best_id != kInvalidIndex && best < -1e-9 * std::max(1e-300, std::abs(state.error()))) {
+          const Move m = state.evaluate(move_edges(best_id));
+          state.apply(m);
+          ++st.swaps_taken;
+          ++gained;
+          if (a >= nu) st.reduced_by_singles -= refund;
+          else st.reduced_by_segments -= std::uint64_t(-undo.reduced);
+          if (best_id >= nu) st.reduced_by_singles += std::uint64_t(m.reduced);
+          else st.reduced_by_segments += std::uint64_t(m.reduced);
+          for (Candidate& c : left)
+            if (c.id == best_id) c.id = a;  // the undone move is a candidate now
+        } else {
+          state.apply(state.evaluate(move_edges(a)));
+        }
+      }
+      if (gained == 0) break;
+    }
+  }
+
+  sel.edge_kept = state.edge_kept();
+  sel.predicted = std::uint64_t(state.count());
   sel.band_enforced = state.count() >= lo && state.count() <= band_hi;
   if (!sel.band_enforced)
     sel.note = "no selection within " + std::to_string(int(std::lround(params.epsilon_n * 100))) +
@@ -448,7 +620,8 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   st.error = state.error() / state.normalisation();
   st.shape = state.shape() / state.normalisation();
   st.cost = st.error + params.lambda_shape * st.shape;
-  sel.objective = sel.greedy_objective = st.cost;
+  sel.objective = st.cost;
+  sel.greedy_objective = st.greedy_cost;
   return out;
 }
 

@@ -63,6 +63,11 @@ struct ShapeSelectionParams {
   /// A single edge collapse (it makes triangles of the quads beside it) competes with segment
   /// collapses at this multiple of its error per triangle-equivalent; 0 disables them.
   double triangle_collapse_factor = 3.0;
+  /// Exchange rounds after the greedy (undo one collapsed move, take a cheaper one instead; see
+  /// select_by_shape) and how many of the cheapest moves left each undone move is tried against.
+  /// 0 rounds = the greedy alone.
+  int swap_rounds = 0;
+  int swap_candidates = 24;
   /// At most this share of the reduction (input − N triangle-equivalents) comes from single
   /// collapses.
   double max_triangle_share = 0.4;
@@ -70,6 +75,7 @@ struct ShapeSelectionParams {
 
 struct ShapeSelectionStats {
   double cost = 0.0;            ///< the selection's cost, normalised (see above)
+  double greedy_cost = 0.0;     ///< the greedy's, before the exchanges
   double error = 0.0;           ///< its geometric part
   double shape = 0.0;           ///< its quad-shape part
   Index segment_collapses = 0;  ///< group (segment) collapses taken
@@ -78,6 +84,7 @@ struct ShapeSelectionStats {
   std::uint64_t reduced_by_singles = 0;   ///< … by single collapses
   std::int64_t evaluations = 0;           ///< move evaluations (the greedy's work)
   Index overshooting_moves = 0;           ///< moves dropped: they would leave Eq. 2's band below
+  Index swaps_tried = 0, swaps_taken = 0;  ///< exchanges tried and taken
   Index invalid_moves = 0;                ///< moves dropped: a face around them would flip or vanish
 };
 
