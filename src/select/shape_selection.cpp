@@ -166,7 +166,7 @@ class ShapeState {
       m.reduced += face_count(f, face_kept_[f]) - face_count(f, face_kept_[f] - face_removed_[f]);
 
     // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
-    {
+    if (params_.check_faces || params_.lambda_shape > 0.0) {
       ++face_tok2_;
       if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
       shape_faces_.clear();

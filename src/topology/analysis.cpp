@@ -124,10 +124,10 @@ AnalysisResult analyze(const PolyMesh& mesh, const Connectivity& conn, const Ana
   r.segmentation = segment_polychords(mesh, conn, r.polychords, params.segmentation);
   r.timings.segmentation_ms = ms_since(t);
   t = Clock::now();
-  r.medial = cluster_medial_curves(mesh, conn, r.polychords, params.medial);
+  if (params.clusters) r.medial = cluster_medial_curves(mesh, conn, r.polychords, params.medial);
   r.timings.medial_ms = ms_since(t);
   t = Clock::now();
-  r.triangles = cluster_triangle_regions(mesh, conn, params.triangles);
+  if (params.clusters) r.triangles = cluster_triangle_regions(mesh, conn, params.triangles);
   r.timings.triangles_ms = ms_since(t);
   r.timings.total_ms = ms_since(t0);
   return r;

@@ -27,6 +27,10 @@ struct AnalysisParams {
   SegmentationParams segmentation;
   MedialClusteringParams medial;
   TriangleClusteringParams triangles;
+  /// Compute the geometric clusters of §3.2.3–§3.2.4 (medial curves and triangle regions). Only
+  /// the paper's objective (Eqs. 6–8) reads them; the shape objective skips them (they were
+  /// 60–75 % of the analysis time on makehuman_base_body).
+  bool clusters = true;
 };
 
 struct AnalysisTimings {
