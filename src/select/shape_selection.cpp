@@ -167,19 +167,10 @@ class ShapeState {
 
     // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
     if (params_.check_faces || params_.lambda_shape > 0.0) {
-      ++face_tok2_;
-      if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
-      shape_faces_.clear();
-      for (const NewCluster& s : sets_)
-        for (Index r : s.roots)
-          for_each_member(r, [&](Index v) {
-            for (Index c : conn_.corners_at_vertex(v)) {
-              const Index f = conn_.corner_face[c];
-              if (face_token2_[f] == face_tok2_) continue;
-              face_token2_[f] = face_tok2_;
-              shape_faces_.push_back(f);
-            }
-          });
+      gather_faces([&](auto&& visit) {
+        for (const NewCluster& s : sets_)
+          for (Index r : s.roots) for_each_member(r, visit);
+      });
       for (Index f : shape_faces_) {
         const Index removed = face_token_[f] == token_ ? face_removed_[f] : 0;
         auto placed = [&](Index v) -> const Vec3& {
@@ -227,16 +218,9 @@ class ShapeState {
       m.error -= err_[r];
       for_each_member(r, [&](Index v) { split_members_.push_back(v); });
     }
-    ++face_tok2_;
-    if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
-    shape_faces_.clear();
-    for (Index v : split_members_)
-      for (Index c : conn_.corners_at_vertex(v)) {
-        const Index f = conn_.corner_face[c];
-        if (face_token2_[f] == face_tok2_) continue;
-        face_token2_[f] = face_tok2_;
-        shape_faces_.push_back(f);
-      }
+    gather_faces([&](auto&& visit) {
+      for (Index v : split_members_) visit(v);
+    });
     for (Index v : split_members_) {
       uf_.reset(v);
       next_member_[v] = v;
@@ -361,6 +345,23 @@ class ShapeState {
     const Vec3& p0 = at(mesh_.corner_vertex[b]);
     const Vec3 area = 0.5 * (at(mesh_.corner_vertex[b + 2]) - p0).cross(at(mesh_.corner_vertex[b + 3]) - at(mesh_.corner_vertex[b + 1]));
     return area.norm() * h_ * h_ * d * d;
+  }
+
+  // Every face with a corner at a vertex that `for_each_vertex(visit)` visits, once, into
+  // shape_faces_.
+  template <class ForEachVertex>
+  void gather_faces(ForEachVertex&& for_each_vertex) {
+    ++face_tok2_;
+    if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
+    shape_faces_.clear();
+    for_each_vertex([&](Index v) {
+      for (Index c : conn_.corners_at_vertex(v)) {
+        const Index f = conn_.corner_face[c];
+        if (face_token2_[f] == face_tok2_) continue;
+        face_token2_[f] = face_tok2_;
+        shape_faces_.push_back(f);
+      }
+    });
   }
 
   template <class F>
