@@ -46,10 +46,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_shape()))->group("Objective");
   sub->add_option("--triangle-collapse-factor", p.triangle_collapse_factor,
                   "Single edge collapses (they make triangles) compete at this multiple of their error (0 = none)")
-      ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_triangle_collapse_factor()))->group("Objective");
+      ->check(CLI::Range(0.0, 1e6))->default_str("3 at ratio <= 0.4 to 6 at >= 0.6")->group("Objective");
   sub->add_option("--max-triangle-share", p.max_triangle_share,
                   "Largest share of the reduction that single collapses may make")
       ->check(CLI::Range(0.0, 1.0))->default_str(std::to_string(default_max_triangle_share()))->group("Objective");
+  sub->add_option("--triangle-penalty", p.triangle_penalty,
+                  "Shape greedy: handicap of a segment collapse per triangle it leaves at its ends, relative to the quads it removes")
+      ->check(CLI::Range(0.0, 1e6))->default_str("0 at ratio <= 0.4 to 1 at >= 0.6")->group("Objective");
   sub->add_option("--swap-rounds", p.swap_rounds,
                   "Exchange rounds after the shape greedy: undo a collapsed move, take a cheaper one (0 = greedy alone)")
       ->check(CLI::Range(0, 64))->default_str(std::to_string(default_swap_rounds()))->group("Objective");

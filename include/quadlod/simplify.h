@@ -41,9 +41,17 @@ struct SimplifyOptions {
   /// below (the paper's objective, for the ablation table).
   std::string objective = "shape";
   double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
-  double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = default, 0 = none
+  double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = by ratio (below), 0 = none
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
   int swap_rounds = -1;                    ///< exchange rounds after the shape greedy; < 0 = default
+  double triangle_penalty = -1.0;          ///< handicap of segment collapses per triangle made; < 0 = by ratio
+  /// Unless given, the two handicaps follow the target ratio r = N / N₀ (docs/shape_objective.md,
+  /// "Quads by ratio"): at r <= aggressive_ratio factor `aggressive_factor` and penalty 0 (most
+  /// of the mesh must go; triangles where they pay), at r >= mild_ratio `mild_factor` and
+  /// `mild_penalty` (a mild LOD keeps its quads), linear in between.
+  double aggressive_ratio = 0.4, mild_ratio = 0.6;
+  double aggressive_factor = 3.0, mild_factor = 6.0;
+  double mild_penalty = 1.0;
   /// > 0: the shape greedy drops moves that flip a face by more than this angle against its
   /// input face or make one degenerate (ShapeSelectionParams::check_faces); 0 = off, the default
   /// (measured worse: docs/shape_objective.md).
@@ -142,7 +150,6 @@ double default_lambda_edge();
 double default_lambda_tri();
 /// The measured defaults of the shape objective (docs/shape_objective.md).
 double default_lambda_shape();
-double default_triangle_collapse_factor();
 double default_max_triangle_share();
 int default_swap_rounds();
 /// The pass ratio and pass count an objective ("shape" or "paper") uses when none is given.

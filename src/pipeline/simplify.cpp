@@ -32,7 +32,6 @@ double default_stall_seconds() { return selection_defaults().whole_stall_seconds
 double default_lambda_edge() { return selection_defaults().lambda_edge; }
 double default_lambda_tri() { return selection_defaults().lambda_tri; }
 double default_lambda_shape() { return ShapeSelectionParams{}.lambda_shape; }
-double default_triangle_collapse_factor() { return ShapeSelectionParams{}.triangle_collapse_factor; }
 double default_max_triangle_share() { return ShapeSelectionParams{}.max_triangle_share; }
 int default_swap_rounds() { return ShapeSelectionParams{}.swap_rounds; }
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
@@ -521,9 +520,18 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   ShapeSelectionParams shp;
   shp.epsilon_n = options.epsilon_n;
   if (options.lambda_shape >= 0.0) shp.lambda_shape = options.lambda_shape;
+  {
+    // Quads by ratio: how much a triangle is worth follows how much of the mesh must go.
+    const double r = result.input_tri_equivalent > 0 ? double(result.target) / double(result.input_tri_equivalent) : 1.0;
+    const double span = options.mild_ratio - options.aggressive_ratio;
+    const double q = span > 0.0 ? std::clamp((r - options.aggressive_ratio) / span, 0.0, 1.0) : (r >= options.mild_ratio ? 1.0 : 0.0);
+    shp.triangle_collapse_factor = options.aggressive_factor + q * (options.mild_factor - options.aggressive_factor);
+    shp.triangle_penalty = q * options.mild_penalty;
+  }
   if (options.triangle_collapse_factor >= 0.0) shp.triangle_collapse_factor = options.triangle_collapse_factor;
   if (options.max_triangle_share >= 0.0) shp.max_triangle_share = options.max_triangle_share;
   if (options.swap_rounds >= 0) shp.swap_rounds = options.swap_rounds;
+  if (options.triangle_penalty >= 0.0) shp.triangle_penalty = options.triangle_penalty;
   DualRepairParams dp;
   dp.enable = options.dual_repair;
   ClusterCollapseParams cp;
@@ -752,6 +760,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"triangle_collapse_factor", shp.triangle_collapse_factor},
       {"max_triangle_share", shp.max_triangle_share},
       {"swap_rounds", shp.swap_rounds},
+      {"triangle_penalty", shp.triangle_penalty},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +

@@ -65,6 +65,7 @@ struct Move {
   double error = 0.0;        // Δ Σ cluster errors (raw units)
   double shape = 0.0;        // Δ Σ quad-shape penalties (raw units, before λ_shape)
   bool valid = true;         // no face around the move flips or degenerates
+  std::int64_t triangles_made = 0;  // faces left with three kept edges (quads or n-gons before)
   double cost(double lambda_shape) const { return error + lambda_shape * shape; }
 };
 
@@ -162,8 +163,10 @@ class ShapeState {
         }
         ++face_removed_[f];
       }
-    for (Index f : touched_faces_)
+    for (Index f : touched_faces_) {
       m.reduced += face_count(f, face_kept_[f]) - face_count(f, face_kept_[f] - face_removed_[f]);
+      if (face_kept_[f] >= 4 && face_kept_[f] - face_removed_[f] == 3) ++m.triangles_made;
+    }
 
     // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
     if (params_.check_faces || params_.lambda_shape > 0.0) {
@@ -474,8 +477,11 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     const double per = m.cost(params.lambda_shape) / double(m.reduced);
     // A handicap that also holds for gains (negative cost): a single collapse is taken only when
     // it is better by the factor.
-    if (id < nu) return per;
-    return per >= 0.0 ? per * single_factor : per / single_factor;
+    // A segment move pays for the triangles it leaves at its ends (where the next segment of the
+    // chord stays): triangle_penalty per triangle made, relative to the quads it removes.
+    const double handicap = id < nu ? 1.0 + params.triangle_penalty * double(m.triangles_made) / std::max(1.0, 0.5 * double(m.reduced))
+                                    : single_factor;
+    return per >= 0.0 ? per * handicap : per / handicap;
   };
 
   std::priority_queue<Candidate> heap;

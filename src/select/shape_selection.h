@@ -68,6 +68,10 @@ struct ShapeSelectionParams {
   /// 0 rounds = the greedy alone.
   int swap_rounds = 0;
   int swap_candidates = 24;
+  /// A segment collapse that leaves t triangles at its ends while removing q quads' worth of
+  /// triangle-equivalents (2q) competes at (1 + triangle_penalty · t / q) times its cost per
+  /// triangle-equivalent; 0 = no handicap.
+  double triangle_penalty = 0.0;
   /// At most this share of the reduction (input − N triangle-equivalents) comes from single
   /// collapses.
   double max_triangle_share = 0.4;
