@@ -17,6 +17,7 @@
 #include <iterator>
 #include <set>
 #include <string>
+#include <tuple>
 
 using namespace quadlod;
 
@@ -216,5 +217,31 @@ TEST(ShapeSelection, ExchangesNeverRaiseTheCost) {
       EXPECT_EQ(r.stats.reduced_by_segments + r.stats.reduced_by_singles, input - r.selection.predicted);
       EXPECT_LE(double(r.stats.reduced_by_singles), params.max_triangle_share * double(input - target) + 1e-9);
     }
+  }
+}
+
+// The triangle penalty steers segment collapses away from leaving triangles at segment ends;
+// the pipeline sets it, and the single-collapse factor, from the target ratio.
+TEST(ShapeSelection, TrianglePenaltyLeavesFewerTriangles) {
+  const Prepared p = prepare(make_demo_vase(32, 24));
+  const std::uint64_t target = tri_equivalent_count(p.mesh) * 6 / 10;
+  auto triangles = [&](double penalty) {
+    ShapeSelectionParams params;
+    params.triangle_collapse_factor = 0.0;
+    params.triangle_penalty = penalty;
+    const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, target, params);
+    EXPECT_TRUE(r.selection.band_enforced) << penalty;
+    return predicted_new_triangles(p.mesh, p.conn, r.selection.edge_kept);
+  };
+  const std::uint64_t free = triangles(0.0), penalised = triangles(10.0);
+  EXPECT_LT(penalised, free) << penalised << " vs " << free;
+  SimplifyOptions options;
+  const PolyMesh vase = make_demo_vase();
+  for (auto [ratio, factor, penalty] : {std::tuple{0.3, 3.0, 0.0}, {0.5, 4.5, 0.5}, {0.7, 6.0, 1.0}}) {
+    options.ratio = ratio;
+    const SimplifyResult r = simplify(vase, options);
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_DOUBLE_EQ(r.report["options"]["triangle_collapse_factor"].get<double>(), factor) << ratio;
+    EXPECT_DOUBLE_EQ(r.report["options"]["triangle_penalty"].get<double>(), penalty) << ratio;
   }
 }
