@@ -66,6 +66,10 @@ struct Move {
   double shape = 0.0;        // Δ Σ quad-shape penalties (raw units, before λ_shape)
   bool valid = true;         // no face around the move flips or degenerates
   std::int64_t triangles_made = 0;  // faces left with three kept edges (quads or n-gons before)
+  // The largest mean squared distance of a cluster's face planes to its vertex (face-plane
+  // weight = area) among the clusters the move makes (evaluate) or dissolves (uncollapse): the
+  // local deviation a Hausdorff distance sees and the summed error hides.
+  double peak2 = 0.0;
   double cost(double lambda_shape) const { return error + lambda_shape * shape; }
 };
 
@@ -149,6 +153,7 @@ class ShapeState {
         for (Index r : s.roots) for_each_member(r, [&](Index v) { visit(mesh_.positions[v]); });
       });
       m.error += s.placement.error;
+      if (s.terms.w > 0.0) m.peak2 = std::max(m.peak2, s.placement.error / s.terms.w);
     }
 
     // Eq. 1: faces along the collapsed edges lose kept edges.
@@ -219,6 +224,7 @@ class ShapeState {
     count_ -= m.reduced;
     for (Index r : split_roots_) {
       m.error -= err_[r];
+      if (terms_[r].w > 0.0) m.peak2 = std::max(m.peak2, err_[r] / terms_[r].w);
       for_each_member(r, [&](Index v) { split_members_.push_back(v); });
     }
     gather_faces([&](auto&& visit) {
@@ -583,6 +589,8 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
           const Move m = state.evaluate(move_edges(c.id));
           ++st.evaluations;
           if (!m.valid || m.reduced <= 0) continue;
+          // No exchange makes a cluster that strays further than the worst one it undoes.
+          if (params.swap_keeps_peak && m.peak2 > undo.peak2) continue;
           const std::int64_t n = state.count() - m.reduced;
           if (n < lo || n > band_hi) continue;
           if (c.id >= nu && st.reduced_by_singles - refund + std::uint64_t(m.reduced) > std::uint64_t(single_budget))

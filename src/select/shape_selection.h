@@ -68,6 +68,9 @@ struct ShapeSelectionParams {
   /// 0 rounds = the greedy alone.
   int swap_rounds = 0;
   int swap_candidates = 24;
+  /// An exchange may not make a cluster whose mean squared plane distance exceeds the largest of
+  /// the clusters it undoes (so it cannot trade a lower sum for a larger worst case).
+  bool swap_keeps_peak = true;
   /// A segment collapse that leaves t triangles at its ends while removing q quads' worth of
   /// triangle-equivalents (2q) competes at (1 + triangle_penalty · t / q) times its cost per
   /// triangle-equivalent; 0 = no handicap.
