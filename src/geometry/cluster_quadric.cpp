@@ -151,9 +151,15 @@ ClusterPlacement solve(const ClusterTerms& t, double h, const QuadricPlacementPa
   const Vec3 centroid = t.psum / t.count;
 
   const double cutoff = std::max(0.0, params.eigen_cutoff);
-  Eigen::LDLT<Eigen::Matrix3d> ldlt(q.A);
-  const bool direct = ldlt.info() == Eigen::Success && ldlt.isPositive() && ldlt.vectorD().minCoeff() > 0.0 &&
-                      ldlt.rcond() > cutoff;
+  // Direct inverse when A is well conditioned: det A > cutoff · ‖A‖_F³ implies (A symmetric
+  // positive semi-definite, ‖A‖_F ≥ λ_max, λ_mid ≤ λ_max) λ_min / λ_max > cutoff. The closed-form
+  // 3×3 inverse is several times cheaper than a factorisation with a condition estimate, and the
+  // selection prices every move with this placement.
+  const double fro = q.A.norm();
+  const double det = q.A.determinant();
+  const bool direct = fro > 0.0 && std::isfinite(det) && det > cutoff * fro * fro * fro;
+  Eigen::Matrix3d inverse;
+  if (direct) inverse = q.A.inverse();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   double lambda_cut = 0.0;
   if (!direct) {
@@ -162,7 +168,7 @@ ClusterPlacement solve(const ClusterTerms& t, double h, const QuadricPlacementPa
     lambda_cut = cutoff * std::max(eig.eigenvalues().cwiseAbs().maxCoeff(), 0.0);
   }
   auto apply_inverse = [&](const Vec3& v) -> Vec3 {
-    if (direct) return ldlt.solve(v);
+    if (direct) return inverse * v;
     Vec3 x = Vec3::Zero();
     for (int i = 0; i < 3; ++i) {
       const double l = eig.eigenvalues()[i];
