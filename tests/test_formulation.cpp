@@ -2,6 +2,7 @@
 #include "select/selection.h"
 #include "quadlod/generators.h"
 #include "topology/analysis.h"
+#include "prepared_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -12,18 +13,8 @@ using namespace quadlod;
 
 namespace {
 
-struct Prepared {
-  PolyMesh mesh;
-  Connectivity conn;
-  AnalysisResult analysis;
-};
-
-Prepared prepare(PolyMesh mesh, const AnalysisParams& ap = {}) {
-  Prepared p{std::move(mesh), {}, {}};
-  p.conn = build_connectivity(p.mesh);
-  p.analysis = analyze(p.mesh, p.conn, ap);
-  return p;
-}
+using select_test::Prepared;
+using select_test::prepare;
 
 // Eq. 9 evaluated directly on edge bits, independent of the model builder.
 double eq9(const Prepared& p, const std::vector<std::uint8_t>& kept, std::uint64_t target,

@@ -6,6 +6,7 @@
 #include "quadlod/io.h"
 #include "quadlod/simplify.h"
 #include "topology/analysis.h"
+#include "prepared_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -26,18 +27,8 @@ using namespace quadlod;
 
 namespace {
 
-struct Prepared {
-  PolyMesh mesh;
-  Connectivity conn;
-  AnalysisResult analysis;
-};
-
-Prepared prepare(PolyMesh mesh) {
-  Prepared p{std::move(mesh), {}, {}};
-  p.conn = build_connectivity(p.mesh);
-  p.analysis = analyze(p.mesh, p.conn);
-  return p;
-}
+using select_test::Prepared;
+using select_test::prepare;
 
 // An 8×3 grid of unit cells with a ridge along y (the vertices on x = 4 lifted by 1), bent
 // across y (z += 0.3 (y − 1.5)²), so that the surface is straight along x away from the ridge
