@@ -1,0 +1,222 @@
+// UV islands of the cluster collapse (issue 7; docs/attributes.md, "Islands neither vanish nor
+// split"): which islands Collapser protects, their edge-connected components before and after
+// the collapse, and the check that refuses the clusters that would make an island vanish or fall
+// apart. The class: collapser.h.
+#include "mesh/union_find.h"
+#include "post/collapser.h"
+
+#include <algorithm>
+
+namespace quadlod::collapse_detail {
+
+// Islands the collapse keeps whole (docs/attributes.md, "Islands neither vanish nor split").
+// Seams are strict, so no cluster joins two islands, but nothing else stopped a cluster from
+// taking an island's last faces — a closed part without any feature line (an eyeball of
+// flightgear_head_amelia, 112 faces, one island) or a lone n-gon decal whose boundary is one
+// feature line (flightgear_cg57_cruiser_hd) collapsed whole — or from cutting it in two: a thin
+// tube (cg57, 4 quads around) whose two middle rings each collapse to a point leaves two cones
+// and drops the faces between, with no new boundary and no non-manifold vertex. Per-face layouts
+// are exempt: they must lose islands to be reduced at all.
+void Collapser::protect_islands() {
+  if (mesh_.uv_sets.empty() || params_.min_kept_island_area < 0.0) return;
+  const UvIslands islands = find_uv_islands(mesh_, conn_, 0);
+  std::vector<Index> size(islands.num_islands, 0);
+  Index with_uv = 0, alone = 0;
+  for (Index f = 0; f < nf_; ++f)
+    if (islands.face_island[f] != kInvalidIndex) ++size[islands.face_island[f]];
+  for (Index f = 0; f < nf_; ++f)
+    if (islands.face_island[f] != kInvalidIndex) {
+      ++with_uv;
+      alone += size[islands.face_island[f]] == 1;
+    }
+  if (double(alone) > params_.features.per_face_layout_fraction * double(with_uv)) return;
+  const Index n = islands.num_islands;
+  if (n == 0) return;
+  face_island_ = islands.face_island;
+  island_begin_.assign(n + 1, 0);
+  for (Index f = 0; f < nf_; ++f)
+    if (face_island_[f] != kInvalidIndex) ++island_begin_[face_island_[f] + 1];
+  for (Index i = 0; i < n; ++i) island_begin_[i + 1] += island_begin_[i];
+  island_faces_.resize(island_begin_[n]);
+  std::vector<Index> fill(island_begin_.begin(), island_begin_.end() - 1);
+  for (Index f = 0; f < nf_; ++f)
+    if (face_island_[f] != kInvalidIndex) island_faces_[fill[face_island_[f]]++] = f;
+  island_keep_.assign(n, 0);
+  island_pieces_.assign(n, 0);
+  for (Index i = 0; i < n; ++i) {
+    double area = islands.area_3d[i];
+    if (params_.face_island_area && params_.face_island_area->size() == nf_)
+      for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k)
+        area = std::max(area, (*params_.face_island_area)[island_faces_[k]]);
+    island_keep_[i] = area > 0.0 && area >= params_.min_kept_island_area;
+    island_pieces_[i] = island_components(i, [&](Index c) { return mesh_.corner_vertex[c]; }, nullptr);
+  }
+  island_token_.assign(n, 0);
+  root_component_.assign(nv_, kInvalidIndex);
+  root_component_token_.assign(nv_, 0);
+}
+
+// Edge-connected components of island i's faces with corners mapped by vertex_of (input
+// vertices, or output vertices = cluster roots over the surviving pieces). piece_component, when
+// given, gets each surviving piece's component, in the order of island_faces_ and pieces.
+template <class VertexOf>
+Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component) {
+  struct Side {
+    Index a, b, piece;
+    bool operator<(const Side& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : piece < o.piece; }
+  };
+  std::vector<Side> sides;
+  Index pieces = 0;
+  const bool built = piece_component != nullptr;
+  for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k) {
+    const Index f = island_faces_[k];
+    if (!built) {  // the input face itself
+      for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
+        const Index a = vertex_of(c), b = vertex_of(mesh_.face_begin(f) + (c + 1 - mesh_.face_begin(f)) % mesh_.face_size(f));
+        sides.push_back({std::min(a, b), std::max(a, b), pieces});
+      }
+      ++pieces;
+      continue;
+    }
+    Index off = piece_base(f);
+    for (Index p = 0; p < piece_count_[f]; ++p) {
+      const Index len = piece_buf_[off];
+      for (Index j = 0; j < len; ++j) {
+        const Index a = vertex_of(piece_buf_[off + 1 + j]), b = vertex_of(piece_buf_[off + 1 + (j + 1) % len]);
+        sides.push_back({std::min(a, b), std::max(a, b), pieces});
+      }
+      ++pieces;
+      off += len + 1;
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  UnionFind uf(pieces);
+  if (!built) {
+    for (std::size_t k = 1; k < sides.size(); ++k)
+      if (sides[k].a == sides[k - 1].a && sides[k].b == sides[k - 1].b) uf.unite(sides[k].piece, sides[k - 1].piece);
+  } else {
+    // find_uv_islands joins faces only across edges with exactly two faces, so an output side
+    // joins two pieces only if no other output face lies on it. A collapse can fold an island
+    // onto itself or onto a coincident sheet (flightgear_cg57_cruiser_hd at 0.6: one side with
+    // three faces of a 24-quad island and two of a twin sheet), and the island is then cut in
+    // two there although its UVs agree across the side. Such sides are kept for the blame.
+    unjoined_sides_.clear();
+    for (std::size_t k = 0; k < sides.size();) {
+      std::size_t end = k + 1;
+      while (end < sides.size() && sides[end].a == sides[k].a && sides[end].b == sides[k].b) ++end;
+      if (end - k == 2 && pieces_on_side(sides[k].a, sides[k].b) == 2)
+        uf.unite(sides[k].piece, sides[k + 1].piece);
+      else if (end - k >= 2)
+        for (std::size_t j = k; j < end; ++j) unjoined_sides_.push_back({sides[j].a, sides[j].b, sides[j].piece});
+      k = end;
+    }
+  }
+  Index components = 0;
+  std::vector<Index> id(pieces, kInvalidIndex);
+  if (built) piece_component->assign(pieces, kInvalidIndex);
+  for (Index p = 0; p < pieces; ++p) {
+    Index& c = id[uf.find(p)];
+    if (c == kInvalidIndex) c = components++;
+    if (built) (*piece_component)[p] = c;
+  }
+  return components;
+}
+
+// Output pieces of every input face, the island's or not, with a side between roots a and b:
+// the sides next to a in its fan. Rebuilds fan_: called from check_islands, after every fan of
+// the round is done.
+Index Collapser::pieces_on_side(Index a, Index b) {
+  gather_fan(a);
+  Index count = 0;
+  for (const auto& e : fan_) {
+    const Index* cs = piece_buf_.data() + e.first;
+    count += root_of_corner(cs[(e.pos + 1) % e.len]) == b;
+    count += root_of_corner(cs[(e.pos + e.len - 1) % e.len]) == b;
+  }
+  return count;
+}
+
+// Islands of dirty faces (refusal `island`):
+//   * vanished: an island of at least min_kept_island_area without any surviving face. The
+//     clusters at the corners of its largest face are refused (split, then dissolved), until that
+//     face survives; refusing every cluster on the island would undo far more than needed.
+//   * split: its surviving pieces fall into more edge-connected components than its input faces
+//     had (one). The clusters at the corners of the dropped faces between two components are
+//     refused — the ring of a tube collapsed to a point on each side of a dropped band.
+void Collapser::check_islands(const std::vector<Index>& dirty) {
+  ++island_tok_;
+  std::vector<Index> piece_component;
+  for (Index f : dirty) {
+    const Index i = face_island_[f];
+    if (i == kInvalidIndex || island_token_[i] == island_tok_) continue;
+    island_token_[i] = island_tok_;
+    const Index* begin = island_faces_.data() + island_begin_[i];
+    const Index* end = island_faces_.data() + island_begin_[i + 1];
+    if (!std::any_of(begin, end, [&](Index g) { return piece_count_[g] > 0; })) {
+      if (!island_keep_[i]) continue;
+      const Index* largest = std::max_element(begin, end, [&](Index a, Index b) { return face_area_[a] < face_area_[b]; });
+      for (Index c = mesh_.face_begin(*largest); c < mesh_.face_end(*largest); ++c)
+        blame(root_of_corner(c), CollapseRefusal::Island);
+      continue;
+    }
+    const Index components = island_components(i, [&](Index c) { return root_of_corner(c); }, &piece_component);
+    if (components <= island_pieces_[i]) continue;
+    // The component of every root on a surviving piece, then the dropped faces touching two.
+    ++component_tok_;
+    Index p = 0;
+    for (const Index* g = begin; g != end; ++g) {
+      Index off = piece_base(*g);
+      for (Index q = 0; q < piece_count_[*g]; ++q, ++p) {
+        const Index len = piece_buf_[off];
+        for (Index j = 0; j < len; ++j) {
+          const Index r = root_of_corner(piece_buf_[off + 1 + j]);
+          if (root_component_token_[r] != component_tok_) {
+            root_component_token_[r] = component_tok_;
+            root_component_[r] = piece_component[p];
+          }
+        }
+        off += len + 1;
+      }
+    }
+    bool blamed_any = false;
+    // A side with more than two faces that would join two components if it had only the
+    // island's two: refuse the clusters at its ends, which made it (the island's own pieces
+    // folded onto one side, or a coincident sheet collapsed onto it).
+    for (std::size_t k = 0; k < unjoined_sides_.size();) {
+      std::size_t side_end = k + 1;
+      bool two = false;
+      while (side_end < unjoined_sides_.size() && unjoined_sides_[side_end].a == unjoined_sides_[k].a &&
+             unjoined_sides_[side_end].b == unjoined_sides_[k].b) {
+        two = two || piece_component[unjoined_sides_[side_end].piece] != piece_component[unjoined_sides_[k].piece];
+        ++side_end;
+      }
+      const Index a = unjoined_sides_[k].a, b = unjoined_sides_[k].b;
+      if (two && (cluster_size(a) > 1 || cluster_size(b) > 1)) {
+        blame(a, CollapseRefusal::Island);
+        blame(b, CollapseRefusal::Island);
+        blamed_any = true;
+      }
+      k = side_end;
+    }
+    for (const Index* g = begin; g != end; ++g) {
+      if (piece_count_[*g] > 0) continue;
+      Index first = kInvalidIndex;
+      bool two = false;
+      for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) {
+        const Index r = root_of_corner(c);
+        if (root_component_token_[r] != component_tok_) continue;
+        if (first == kInvalidIndex) first = root_component_[r];
+        else two = two || root_component_[r] != first;
+      }
+      if (!two) continue;
+      blamed_any = true;
+      for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) blame(root_of_corner(c), CollapseRefusal::Island);
+    }
+    if (!blamed_any)  // no dropped face between two pieces: refuse every cluster on a dropped face
+      for (const Index* g = begin; g != end; ++g)
+        if (piece_count_[*g] == 0)
+          for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) blame(root_of_corner(c), CollapseRefusal::Island);
+  }
+}
+
+}  // namespace quadlod::collapse_detail
