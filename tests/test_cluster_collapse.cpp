@@ -383,6 +383,36 @@ TEST(ClusterCollapse, CreaseVerticesStayOnTheCrease) {
   }
 }
 
+// Clusters whose only feature is a hard edge (the 90° crease above) follow their quadric unless
+// place_on_hard_edges (issue 19): with it they sit exactly on the crease line (issue 7's rule),
+// without it exactly where the plain quadric puts them (the collapse without features), which is
+// off the line by Knodt's tangential planes. The boundary ends of the chord (j = 0, 4) are on a
+// strict line either way and are left out.
+TEST(ClusterCollapse, HardEdgePlacementIsOptional) {
+  const PolyMesh in = folded_grid();
+  const Connectivity conn = build_connectivity(in);
+  auto id = [](Index i, Index j) { return j * 5 + i; };
+  std::vector<std::pair<Index, Index>> chord;
+  for (Index j = 0; j <= 4; ++j) chord.emplace_back(id(1, j), id(2, j));
+  ClusterCollapseParams pinned, free, plain;
+  pinned.place_on_hard_edges = true;
+  plain.respect_features = false;
+  const ClusterCollapseResult on = collapse_clusters(in, conn, select(conn, chord), pinned);
+  const ClusterCollapseResult off = collapse_clusters(in, conn, select(conn, chord), free);
+  const ClusterCollapseResult bare = collapse_clusters(in, conn, select(conn, chord), plain);
+  expect_valid_output(in, on);
+  expect_valid_output(in, off);
+  for (Index j = 1; j <= 3; ++j) {
+    const Vec3& a = on.mesh.positions[on.vertex_map[id(2, j)]];
+    EXPECT_NEAR(a.x(), 0.5, 1e-12) << j;
+    EXPECT_NEAR(a.z(), 0.0, 1e-12) << j;
+    const Vec3& b = off.mesh.positions[off.vertex_map[id(2, j)]];
+    const Vec3& c = bare.mesh.positions[bare.vertex_map[id(2, j)]];
+    EXPECT_NEAR((b - c).norm(), 0.0, 1e-12) << j;
+    EXPECT_GT(std::abs(b.x() - 0.5) + std::abs(b.z()), 1e-9) << j;
+  }
+}
+
 // A flat 3×3 block of vertices merged into one. With every term that makes the system regular
 // turned off, the quadric is rank one (only the plane z = 0): the pseudo-inverse around the
 // centroid must still give a finite point inside the block.

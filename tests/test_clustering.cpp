@@ -285,6 +285,24 @@ TEST(AnalysisCluster, AnalyzeRunsEveryStageConsistently) {
   EXPECT_NE(analysis_summary(f.mesh, a).find("26 chords"), std::string::npos);
 }
 
+// Without the geometric clusters (the shape objective does not read them) the chords and
+// segments are the same and the clusters are empty.
+TEST(AnalysisCluster, ClustersCanBeSkipped) {
+  const Fixture f = make_fixture("vase", make_demo_vase(16, 10));
+  const AnalysisResult all = analyze(f.mesh, f.conn);
+  AnalysisParams ap;
+  ap.clusters = false;
+  const AnalysisResult some = analyze(f.mesh, f.conn, ap);
+  EXPECT_FALSE(all.medial.clusters.empty());
+  EXPECT_FALSE(all.triangles.clusters.empty());
+  EXPECT_TRUE(some.medial.clusters.empty());
+  EXPECT_TRUE(some.triangles.clusters.empty());
+  EXPECT_EQ(some.polychords.chords.size(), all.polychords.chords.size());
+  ASSERT_EQ(some.segmentation.segments.size(), all.segmentation.segments.size());
+  for (std::size_t i = 0; i < all.segmentation.segments.size(); ++i)
+    EXPECT_EQ(some.segmentation.segments[i].opposing_edges, all.segmentation.segments[i].opposing_edges);
+}
+
 TEST(AnalysisCluster, ExportWritesColouredEdgeFiles) {
   const Fixture f = make_fixture("vase", make_demo_vase(8, 4));
   const AnalysisResult a = analyze(f.mesh, f.conn);

@@ -126,7 +126,9 @@ TEST(ShapeSelection, SingleCollapsesStayWithinTheirShare) {
   EXPECT_GT(r.stats.single_collapses, 0);
   EXPECT_LE(double(r.stats.reduced_by_singles), 0.2 * double(input - target));
   // The cap holds even where the segments left cannot land in Eq. 2's band: the note says so.
-  if (!r.selection.band_enforced) EXPECT_NE(r.selection.note.find("no selection within 3 %"), std::string::npos);
+  if (!r.selection.band_enforced) {
+    EXPECT_NE(r.selection.note.find("no selection within 3 %"), std::string::npos);
+  }
 
   ShapeSelectionParams none;
   none.triangle_collapse_factor = 0.0;
@@ -252,4 +254,28 @@ TEST(ShapeSelection, TrianglePenaltyLeavesFewerTriangles) {
     EXPECT_DOUBLE_EQ(r.report["options"]["triangle_collapse_factor"].get<double>(), factor) << ratio;
     EXPECT_DOUBLE_EQ(r.report["options"]["triangle_penalty"].get<double>(), penalty) << ratio;
   }
+}
+
+// Progress (issue 20): the percentage is the share of the reduction done — it never falls and
+// ends at 100 — and a reduction in 16 passes prints a few lines, not a few per pass.
+TEST(ShapeSelection, ProgressCountsWorkAndIsThrottled) {
+  SimplifyOptions options;
+  options.ratio = 0.2;
+  options.progress = true;
+  ::testing::internal::CaptureStderr();
+  const SimplifyResult r = simplify(make_demo_vase(), options);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_GE(r.report["passes"].size(), 10u);
+  int lines = 0, last = -1;
+  for (std::size_t at = 0; (at = err.find("[", at)) != std::string::npos; ++at) {
+    const std::size_t close = err.find(']', at);
+    if (close == std::string::npos || err.compare(at + 2, 1, "/") != 0) continue;
+    const int pct = std::stoi(err.substr(close + 11, 4));
+    EXPECT_GE(pct, last) << err;
+    last = pct;
+    ++lines;
+  }
+  EXPECT_EQ(last, 100) << err;
+  EXPECT_LE(lines, 8) << err;  // the demo takes well under a second: the first and the final line
 }

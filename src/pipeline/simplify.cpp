@@ -256,6 +256,11 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   std::vector<std::uint8_t> pinned;
   std::optional<FeatureEdges> feat;  // computed once per pass: pins here, the collapse's rules
   ClusterCollapseParams pass_cp = cp;
+  // The vertex quadrics of this pass's input, once for the shape selection and every collapse
+  // round (geometry/cluster_quadric.h: the placement both use).
+  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement);
+  pass_cp.vertex_quadrics = &quadrics;
+  shp.vertex_quadrics = &quadrics;
   if (options.features) {
     clock = Stopwatch();
     feat = find_feature_edges(input, conn, cp.features);

@@ -110,7 +110,12 @@ void Collapser::precompute() {
 //   * edge planes carry |e| · h / 2π instead of |e| / h, so edge and face terms have the same
 //     units (area) and, on a regular quad grid, the same ratio as in Knodt's code.
 void Collapser::build_vertex_terms() {
-  terms_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement).terms;
+  if (params_.vertex_quadrics) {
+    terms_ = &params_.vertex_quadrics->terms;
+    return;
+  }
+  own_quadrics_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement);
+  terms_ = &own_quadrics_.terms;
 }
 
 void Collapser::initial_clusters(const std::vector<std::uint8_t>& edge_kept) {
@@ -155,7 +160,7 @@ void Collapser::initial_clusters(const std::vector<std::uint8_t>& edge_kept) {
 void Collapser::place(Index r) {
   const auto ms = members(r);
   ClusterTerms t;
-  for (Index m : ms) t.add_vertex(terms_[m], mesh_.positions[m]);
+  for (Index m : ms) t.add_vertex((*terms_)[m], mesh_.positions[m]);
   if (features_on_) {
     // place_on_feature minimises the regularised quadric along the line.
     if (place_on_feature(r, regularized_quadric(t, h_, params_.placement))) {

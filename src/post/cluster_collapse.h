@@ -74,6 +74,10 @@ SurfaceReference make_surface_reference(const PolyMesh& mesh);
 struct ClusterCollapseParams {
   // --- placement: the cluster quadric (geometry/cluster_quadric.h) -------------------------
   QuadricPlacementParams placement;
+  /// build_vertex_quadrics(mesh, conn, placement) of the mesh being collapsed, borrowed (must
+  /// outlive the call); nullptr: built here. simplify() builds them once per pass for the shape
+  /// selection and every collapse round of that pass.
+  const VertexQuadrics* vertex_quadrics = nullptr;
 
   /// Clusters on hard edges (dihedral >= FeatureParams::hard_angle_deg, or smoothing groups) but
   /// on no other feature are placed on the hard line or at its corner (issue 7's rule) when true;

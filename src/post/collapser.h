@@ -102,7 +102,8 @@ class Collapser {
   std::vector<Vec3> face_n_;       // unit normal of each input face (zero if no area)
   std::vector<double> face_area_;  // area of each input face
   std::vector<double> edge_len_;
-  std::vector<VertexTerms> terms_;
+  VertexQuadrics own_quadrics_;
+  const std::vector<VertexTerms>* terms_ = nullptr;  // params_.vertex_quadrics' or own_quadrics_'s
   std::vector<std::int8_t> input_nm_;  // input vertex non-manifold: 1 / 0, −1 not computed yet
   bool features_on_ = false;
   // UV islands (set 0) the collapse must neither cut in pieces nor, from

@@ -78,7 +78,9 @@ class ShapeState {
   ShapeState(const PolyMesh& mesh, const Connectivity& conn, const ShapeSelectionParams& params)
       : mesh_(mesh), conn_(conn), params_(params), uf_(mesh.num_vertices()) {
     const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
-    const VertexQuadrics vq = build_vertex_quadrics(mesh, conn, params.placement);
+    VertexQuadrics own;
+    if (!params.vertex_quadrics) own = build_vertex_quadrics(mesh, conn, params.placement);
+    const VertexQuadrics& vq = params.vertex_quadrics ? *params.vertex_quadrics : own;
     h_ = vq.mean_edge;
     terms_.resize(nv);
     for (Index v = 0; v < nv; ++v) terms_[v].add_vertex(vq.terms[v], mesh.positions[v]);
@@ -104,7 +106,7 @@ class ShapeState {
     cos_flip_ = std::cos(std::clamp(params.flip_angle_deg, 1e-6, 180.0) * std::numbers::pi / 180.0);
     min_area2_ = 2.0 * std::max(0.0, params.zero_area_epsilon) * diag * diag;
     norm_ = (area > 0.0 ? area : 1.0) * (diag > 0.0 ? diag * diag : 1.0);
-    for (Index f = 0; f < nf; ++f) count_ += face_count(f, face_kept_[f]);
+    for (Index f = 0; f < nf; ++f) count_ += tri_equivalents(face_kept_[f]);
     root_token_.assign(nv, 0);
     root_local_.assign(nv, 0);
     face_token_.assign(nf, 0);
@@ -169,7 +171,7 @@ class ShapeState {
         ++face_removed_[f];
       }
     for (Index f : touched_faces_) {
-      m.reduced += face_count(f, face_kept_[f]) - face_count(f, face_kept_[f] - face_removed_[f]);
+      m.reduced += tri_equivalents(face_kept_[f]) - tri_equivalents(face_kept_[f] - face_removed_[f]);
       if (face_kept_[f] >= 4 && face_kept_[f] - face_removed_[f] == 3) ++m.triangles_made;
     }
 
@@ -186,7 +188,7 @@ class ShapeState {
           if (root_token_[r] == token_) return sets_[set_of_[find_local(root_local_[r])]].placement.position;
           return pos_[r];
         };
-        if (params_.check_faces && face_count(f, face_kept_[f] - removed) > 0 && !faces_like_input(f, placed)) {
+        if (params_.check_faces && tri_equivalents(face_kept_[f] - removed) > 0 && !faces_like_input(f, placed)) {
           m.valid = false;
           return m;
         }
@@ -209,9 +211,9 @@ class ShapeState {
       kept_[e] = 1;
       for (Index c : conn_.corners_of_edge(e)) {
         const Index f = conn_.corner_face[c];
-        const std::int64_t before = face_count(f, face_kept_[f]);
+        const std::int64_t before = tri_equivalents(face_kept_[f]);
         ++face_kept_[f];
-        m.reduced -= face_count(f, face_kept_[f]) - before;
+        m.reduced -= tri_equivalents(face_kept_[f]) - before;
       }
       for (Index v : conn_.edge_vertices[e]) {
         const Index r = uf_.find(v);
@@ -310,7 +312,8 @@ class ShapeState {
     ClusterPlacement placement;
   };
 
-  static std::int64_t face_count(Index /*f*/, Index kept) { return kept > 2 ? kept - 2 : 0; }
+  // Eq. 1: a face with `kept` kept edges counts max(0, kept − 2) triangle-equivalents.
+  static std::int64_t tri_equivalents(Index kept) { return kept > 2 ? kept - 2 : 0; }
 
   // The face after the move (its corners at their clusters' positions; corners in one cluster
   // fall together, which Newell's sum ignores) must face the way its input face did, within
@@ -438,8 +441,14 @@ struct Candidate {
   }
 };
 
-std::uint64_t lower_band(std::uint64_t target, double eps) {
-  return static_cast<std::uint64_t>(std::ceil((1.0 - eps) * double(target) - 1e-9));
+// Eq. 2's band in whole triangle-equivalents: [⌈(1 − ϵ_N) N⌉, ⌊(1 + ϵ_N) N⌋].
+struct Band {
+  std::int64_t lo, hi;
+  bool holds(std::int64_t n) const { return n >= lo && n <= hi; }
+};
+Band eq2_band(std::uint64_t target, double eps) {
+  return {std::int64_t(std::ceil((1.0 - eps) * double(target) - 1e-9)),
+          std::int64_t(std::floor((1.0 + eps) * double(target) + 1e-9))};
 }
 
 }  // namespace
@@ -464,7 +473,8 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     sel.band_enforced = true;
     return out;
   }
-  const std::int64_t lo = std::int64_t(lower_band(target, params.epsilon_n));
+  const Band band = eq2_band(target, params.epsilon_n);
+  const std::int64_t lo = band.lo;
   const double single_factor = params.triangle_collapse_factor;
   const bool singles = params.consistency && single_factor > 0.0 && params.max_triangle_share > 0.0;
   const std::int64_t single_budget =
@@ -472,6 +482,12 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   const Index nu = units.count();
 
   // A single collapse is a candidate where it differs from its unit's collapse.
+  // A unit whose every edge is collapsed (a unit with a pinned edge never is).
+  auto wholly_collapsed = [&](Index u) {
+    for (Index e : units.of(u))
+      if (state.kept(e)) return false;
+    return true;
+  };
   auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.g.edge_group[e]).size() > 1; };
   Index single_scratch = 0;
   auto move_edges = [&](Index id) -> std::span<const Index> {
@@ -535,7 +551,6 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     }
   }
 
-  const std::int64_t band_hi = std::int64_t(std::floor((1.0 + params.epsilon_n) * double(target) + 1e-9));
   st.greedy_cost = (state.error() + params.lambda_shape * state.shape()) / state.normalisation();
   sel.greedy_predicted = std::uint64_t(state.count());
 
@@ -544,16 +559,14 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   // over would cost. Each round undoes every collapsed move in turn (by id) and collapses instead
   // the best of the `swap_candidates` cheapest moves left, when that lowers the cost and keeps
   // N' in Eq. 2's band; otherwise the move is redone. Work is counted in moves, not seconds.
-  if (params.swap_rounds > 0 && state.count() >= lo && state.count() <= band_hi) {
+  if (params.swap_rounds > 0 && band.holds(state.count())) {
     std::vector<Index> taken;  // collapsed moves: units wholly collapsed, and single edges
     for (int round = 0; round < params.swap_rounds; ++round) {
       taken.clear();
       std::vector<std::uint8_t> whole(nu, 0);
       for (Index u = 0; u < nu; ++u) {
-        bool all = !units.g.fixed[u];
-        for (Index e : units.of(u)) all = all && !state.kept(e);
-        whole[u] = all;
-        if (all) taken.push_back(u);
+        whole[u] = wholly_collapsed(u);
+        if (whole[u]) taken.push_back(u);
       }
       if (singles)
         for (Index e = 0; e < conn.num_edges; ++e)
@@ -592,7 +605,7 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
           // No exchange makes a cluster that strays further than the worst one it undoes.
           if (params.swap_keeps_peak && m.peak2 > undo.peak2) continue;
           const std::int64_t n = state.count() - m.reduced;
-          if (n < lo || n > band_hi) continue;
+          if (!band.holds(n)) continue;
           if (c.id >= nu && st.reduced_by_singles - refund + std::uint64_t(m.reduced) > std::uint64_t(single_budget))
             continue;
           const double total = undo.cost(params.lambda_shape) + m.cost(params.lambda_shape);
@@ -623,15 +636,11 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
 
   sel.edge_kept = state.edge_kept();
   sel.predicted = std::uint64_t(state.count());
-  sel.band_enforced = state.count() >= lo && state.count() <= band_hi;
+  sel.band_enforced = band.holds(state.count());
   if (!sel.band_enforced)
     sel.note = "no selection within " + std::to_string(int(std::lround(params.epsilon_n * 100))) +
                " % of the target was found by the shape greedy (closest N' " + std::to_string(state.count()) + ")";
-  for (Index u = 0; u < nu; ++u) {
-    bool all = true;
-    for (Index e : units.of(u)) all = all && !state.kept(e);
-    sel.collapsed_groups += all;
-  }
+  for (Index u = 0; u < nu; ++u) sel.collapsed_groups += wholly_collapsed(u);
   st.error = state.error() / state.normalisation();
   st.shape = state.shape() / state.normalisation();
   st.cost = st.error + params.lambda_shape * st.shape;

@@ -52,6 +52,8 @@ struct ShapeSelectionParams {
   /// The placement the collapse will use (ClusterCollapseParams::placement): the cost is priced
   /// at the same positions.
   QuadricPlacementParams placement;
+  /// build_vertex_quadrics(mesh, conn, placement) of the same mesh, borrowed; nullptr: built here.
+  const VertexQuadrics* vertex_quadrics = nullptr;
   /// λ_shape: weight of the quad-shape term (see above); 0 = geometric error alone.
   double lambda_shape = 0.0;
   /// Moves that would flip a face beyond this angle against its input face, or leave a kept face
