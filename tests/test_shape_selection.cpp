@@ -113,6 +113,27 @@ TEST(ShapeSelection, SameInputSameSelection) {
   EXPECT_EQ(a.stats.cost, b.stats.cost);
 }
 
+// The first pricing of all candidates runs on several threads (forced here on a small mesh):
+// each thread prices its own chunk against the same input state, so the selection, its cost
+// and its work count are those of one thread, for any thread count.
+TEST(ShapeSelection, ParallelFirstPricingSelectsTheSame) {
+  const Prepared p = prepare(make_demo_vase(24, 16));
+  const std::uint64_t target = tri_equivalent_count(p.mesh) / 3;
+  ShapeSelectionParams params;
+  params.threads = 1;
+  const ShapeSelectionResult one = select_by_shape(p.mesh, p.conn, p.analysis, target, params);
+  ASSERT_GT(one.stats.single_collapses + one.stats.segment_collapses, 0u);
+  params.min_parallel_candidates = 0;
+  for (int threads : {2, 3, 7}) {
+    params.threads = threads;
+    const ShapeSelectionResult r = select_by_shape(p.mesh, p.conn, p.analysis, target, params);
+    EXPECT_EQ(r.selection.edge_kept, one.selection.edge_kept) << threads << " threads";
+    EXPECT_EQ(r.stats.cost, one.stats.cost);
+    EXPECT_EQ(r.stats.evaluations, one.stats.evaluations);
+    EXPECT_EQ(r.stats.single_collapses, one.stats.single_collapses);
+  }
+}
+
 // Single collapses (they make triangles) are capped at their share of the reduction, and absent
 // when their factor is 0.
 TEST(ShapeSelection, SingleCollapsesStayWithinTheirShare) {

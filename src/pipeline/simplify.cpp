@@ -524,6 +524,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   }
   ShapeSelectionParams shp;
   shp.epsilon_n = options.epsilon_n;
+  shp.threads = options.threads;
   if (options.lambda_shape >= 0.0) shp.lambda_shape = options.lambda_shape;
   {
     // Quads by ratio: how much a triangle is worth follows how much of the mesh must go.

@@ -56,16 +56,44 @@ void Collapser::protect_islands() {
   root_component_token_.assign(nv_, 0);
 }
 
+// Sorts sides_ by (a, b, piece), the order the blame of check_islands follows. The whole-mesh
+// island of a UV grid has four sides per face, and a comparison sort of them was the largest
+// cost of a pass on a 1M-face grid (issue 20), so a large set is bucketed by a (a counting sort
+// over the roots, which are vertex ids) and each bucket, a vertex's few sides, sorted in place.
+// The order is the same either way.
+void Collapser::sort_sides() {
+  auto less = [](const IslandSide& x, const IslandSide& y) {
+    return x.a != y.a ? x.a < y.a : x.b != y.b ? x.b < y.b : x.piece < y.piece;
+  };
+  // Bucketing costs O(vertices): only where the sides are as many as a quarter of them (the
+  // output is the same; this is speed only).
+  if (sides_.size() * 4 < std::size_t(nv_)) {
+    std::sort(sides_.begin(), sides_.end(), less);
+    return;
+  }
+  side_bucket_.assign(std::size_t(nv_) + 1, 0);
+  for (const IslandSide& s : sides_) ++side_bucket_[s.a + 1];
+  for (Index v = 0; v < nv_; ++v) side_bucket_[v + 1] += side_bucket_[v];
+  sides_sorted_.resize(sides_.size());
+  for (const IslandSide& s : sides_) sides_sorted_[side_bucket_[s.a]++] = s;
+  // side_bucket_[v] is now the end of bucket v, the start of bucket v + 1.
+  Index begin = 0;
+  for (Index v = 0; v < nv_; ++v) {
+    const Index end = side_bucket_[v];
+    if (end - begin > 1) std::sort(sides_sorted_.begin() + begin, sides_sorted_.begin() + end, less);
+    begin = end;
+  }
+  sides_.swap(sides_sorted_);
+}
+
 // Edge-connected components of island i's faces with corners mapped by vertex_of (input
 // vertices, or output vertices = cluster roots over the surviving pieces). piece_component, when
 // given, gets each surviving piece's component, in the order of island_faces_ and pieces.
 template <class VertexOf>
 Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component) {
-  struct Side {
-    Index a, b, piece;
-    bool operator<(const Side& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : piece < o.piece; }
-  };
-  std::vector<Side> sides;
+  std::vector<IslandSide>& sides = sides_;
+  sides.clear();
+  fan_root_ = kInvalidIndex;  // fan_ may have been rebuilt since the last call
   Index pieces = 0;
   const bool built = piece_component != nullptr;
   for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k) {
@@ -89,7 +117,7 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
       off += len + 1;
     }
   }
-  std::sort(sides.begin(), sides.end());
+  sort_sides();
   UnionFind uf(pieces);
   if (!built) {
     for (std::size_t k = 1; k < sides.size(); ++k)
@@ -126,7 +154,11 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
 // the sides next to a in its fan. Rebuilds fan_: called from check_islands, after every fan of
 // the round is done.
 Index Collapser::pieces_on_side(Index a, Index b) {
-  gather_fan(a);
+  // Sides arrive sorted by a, so consecutive calls share a's fan.
+  if (fan_root_ != a) {
+    gather_fan(a);
+    fan_root_ = a;
+  }
   Index count = 0;
   for (const auto& e : fan_) {
     const Index* cs = piece_buf_.data() + e.first;

@@ -122,7 +122,12 @@ class Collapser {
     Index a, b, piece;
   };
   std::vector<IslandSide> unjoined_sides_;
+  // Scratch of island_components: the sides, and their bucket sort by first root.
+  std::vector<IslandSide> sides_, sides_sorted_;
+  std::vector<Index> side_bucket_;
+  Index fan_root_ = kInvalidIndex;  // root whose fan_ pieces_on_side gathered last
   Index component_tok_ = 0;
+  void sort_sides();
   void protect_islands();
   void check_islands(const std::vector<Index>& dirty);
   template <class VertexOf>

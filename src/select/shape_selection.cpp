@@ -22,6 +22,9 @@
 #include <numeric>
 #include <queue>
 #include <span>
+#include <atomic>
+#include <mutex>
+#include <thread>
 
 namespace quadlod {
 
@@ -73,18 +76,52 @@ struct Move {
   double cost(double lambda_shape) const { return error + lambda_shape * shape; }
 };
 
+// Scratch of one pricing (ShapeState::evaluate): the local union-find over the old roots a move
+// joins, the faces it touches and the clusters it makes. Tokens mark what the current pricing
+// has seen, so nothing is cleared per move.
+struct Scratch {
+  Scratch() = default;
+  Scratch(Index nv, Index nf) : root_token(nv, 0), root_local(nv, 0), face_token(nf, 0), face_removed(nf, 0) {}
+  struct NewCluster {
+    ClusterTerms terms;
+    std::vector<Index> roots;
+    ClusterPlacement placement;
+  };
+  Index token = 0, face_tok2 = 0;
+  std::vector<Index> root_token, root_local, face_token, face_removed, face_token2;
+  std::vector<Index> locals, local_parent, set_of, moved_edges, touched_faces, shape_faces;
+  std::vector<NewCluster> sets;
+
+  Index local_of(Index root) {
+    if (root_token[root] != token) {
+      root_token[root] = token;
+      root_local[root] = Index(locals.size());
+      locals.push_back(root);
+      local_parent.push_back(Index(local_parent.size()));
+    }
+    return root_local[root];
+  }
+  Index find_local(Index x) {
+    while (local_parent[x] != x) x = local_parent[x] = local_parent[local_parent[x]];
+    return x;
+  }
+  void unite_local(Index a, Index b) {
+    a = find_local(a);
+    b = find_local(b);
+    if (a != b) local_parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
 class ShapeState {
  public:
   ShapeState(const PolyMesh& mesh, const Connectivity& conn, const ShapeSelectionParams& params)
       : mesh_(mesh), conn_(conn), params_(params), uf_(mesh.num_vertices()) {
     const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
-    VertexQuadrics own;
-    if (!params.vertex_quadrics) own = build_vertex_quadrics(mesh, conn, params.placement);
-    const VertexQuadrics& vq = params.vertex_quadrics ? *params.vertex_quadrics : own;
-    h_ = vq.mean_edge;
+    if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement);
+    quadrics_ = params.vertex_quadrics ? params.vertex_quadrics : &own_quadrics_;
+    h_ = quadrics_->mean_edge;
     terms_.resize(nv);
-    for (Index v = 0; v < nv; ++v) terms_[v].add_vertex(vq.terms[v], mesh.positions[v]);
-    base_terms_ = terms_;
+    for (Index v = 0; v < nv; ++v) terms_[v] = vertex_alone(v);
     err_.assign(nv, 0.0);  // a lone vertex sits on all of its planes
     pos_ = mesh.positions;
     next_member_.resize(nv);
@@ -107,10 +144,7 @@ class ShapeState {
     min_area2_ = 2.0 * std::max(0.0, params.zero_area_epsilon) * diag * diag;
     norm_ = (area > 0.0 ? area : 1.0) * (diag > 0.0 ? diag * diag : 1.0);
     for (Index f = 0; f < nf; ++f) count_ += tri_equivalents(face_kept_[f]);
-    root_token_.assign(nv, 0);
-    root_local_.assign(nv, 0);
-    face_token_.assign(nf, 0);
-    face_removed_.assign(nf, 0);
+    main_ = Scratch(nv, nf);
   }
 
   std::int64_t count() const { return count_; }
@@ -121,36 +155,42 @@ class ShapeState {
   const std::vector<std::uint8_t>& edge_kept() const { return kept_; }
 
   // Prices collapsing the kept edges among `edges`; the scratch then holds the move for apply().
-  Move evaluate(std::span<const Index> edges) {
-    ++token_;
-    locals_.clear();
-    local_parent_.clear();
-    moved_edges_.clear();
+  Move evaluate(std::span<const Index> edges) { return evaluate(edges, main_); }
+
+  // Scratch for pricing beside evaluate(edges) (another thread's): evaluate(edges, scratch)
+  // only reads the state while no move is applied yet (every vertex its own root, so
+  // UnionFind::find writes nothing), which is when the greedy prices all its candidates.
+  Scratch make_scratch() const { return Scratch(mesh_.num_vertices(), mesh_.num_faces()); }
+  Move evaluate(std::span<const Index> edges, Scratch& sc) {
+    ++sc.token;
+    sc.locals.clear();
+    sc.local_parent.clear();
+    sc.moved_edges.clear();
     for (Index e : edges) {
       if (!kept_[e]) continue;
-      moved_edges_.push_back(e);
+      sc.moved_edges.push_back(e);
       const auto [a, b] = conn_.edge_vertices[e];
-      const Index la = local_of(uf_.find(a)), lb = local_of(uf_.find(b));
-      unite_local(la, lb);
+      const Index la = sc.local_of(uf_.find(a)), lb = sc.local_of(uf_.find(b));
+      sc.unite_local(la, lb);
     }
     Move m;
-    if (moved_edges_.empty()) return m;
+    if (sc.moved_edges.empty()) return m;
 
     // New clusters: the sums of their old clusters' terms, placed.
-    set_of_.assign(locals_.size(), kInvalidIndex);
-    sets_.clear();
-    for (std::size_t i = 0; i < locals_.size(); ++i) {
-      const Index r = find_local(Index(i));
-      if (set_of_[r] == kInvalidIndex) {
-        set_of_[r] = Index(sets_.size());
-        sets_.push_back({});
+    sc.set_of.assign(sc.locals.size(), kInvalidIndex);
+    sc.sets.clear();
+    for (std::size_t i = 0; i < sc.locals.size(); ++i) {
+      const Index r = sc.find_local(Index(i));
+      if (sc.set_of[r] == kInvalidIndex) {
+        sc.set_of[r] = Index(sc.sets.size());
+        sc.sets.push_back({});
       }
-      NewCluster& s = sets_[set_of_[r]];
-      s.terms += terms_[locals_[i]];
-      s.roots.push_back(locals_[i]);
-      m.error -= err_[locals_[i]];
+      NewCluster& s = sc.sets[sc.set_of[r]];
+      s.terms += terms_[sc.locals[i]];
+      s.roots.push_back(sc.locals[i]);
+      m.error -= err_[sc.locals[i]];
     }
-    for (NewCluster& s : sets_) {
+    for (NewCluster& s : sc.sets) {
       s.placement = place_cluster(s.terms, h_, params_.placement, [&](auto&& visit) {
         for (Index r : s.roots) for_each_member(r, [&](Index v) { visit(mesh_.positions[v]); });
       });
@@ -159,33 +199,33 @@ class ShapeState {
     }
 
     // Eq. 1: faces along the collapsed edges lose kept edges.
-    touched_faces_.clear();
-    for (Index e : moved_edges_)
+    sc.touched_faces.clear();
+    for (Index e : sc.moved_edges)
       for (Index c : conn_.corners_of_edge(e)) {
         const Index f = conn_.corner_face[c];
-        if (face_token_[f] != token_) {
-          face_token_[f] = token_;
-          face_removed_[f] = 0;
-          touched_faces_.push_back(f);
+        if (sc.face_token[f] != sc.token) {
+          sc.face_token[f] = sc.token;
+          sc.face_removed[f] = 0;
+          sc.touched_faces.push_back(f);
         }
-        ++face_removed_[f];
+        ++sc.face_removed[f];
       }
-    for (Index f : touched_faces_) {
-      m.reduced += tri_equivalents(face_kept_[f]) - tri_equivalents(face_kept_[f] - face_removed_[f]);
-      if (face_kept_[f] >= 4 && face_kept_[f] - face_removed_[f] == 3) ++m.triangles_made;
+    for (Index f : sc.touched_faces) {
+      m.reduced += tri_equivalents(face_kept_[f]) - tri_equivalents(face_kept_[f] - sc.face_removed[f]);
+      if (face_kept_[f] >= 4 && face_kept_[f] - sc.face_removed[f] == 3) ++m.triangles_made;
     }
 
     // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
     if (params_.check_faces || params_.lambda_shape > 0.0) {
-      gather_faces([&](auto&& visit) {
-        for (const NewCluster& s : sets_)
+      gather_faces(sc, [&](auto&& visit) {
+        for (const NewCluster& s : sc.sets)
           for (Index r : s.roots) for_each_member(r, visit);
       });
-      for (Index f : shape_faces_) {
-        const Index removed = face_token_[f] == token_ ? face_removed_[f] : 0;
+      for (Index f : sc.shape_faces) {
+        const Index removed = sc.face_token[f] == sc.token ? sc.face_removed[f] : 0;
         auto placed = [&](Index v) -> const Vec3& {
           const Index r = uf_.find(v);
-          if (root_token_[r] == token_) return sets_[set_of_[find_local(root_local_[r])]].placement.position;
+          if (sc.root_token[r] == sc.token) return sc.sets[sc.set_of[sc.find_local(sc.root_local[r])]].placement.position;
           return pos_[r];
         };
         if (params_.check_faces && tri_equivalents(face_kept_[f] - removed) > 0 && !faces_like_input(f, placed)) {
@@ -202,8 +242,9 @@ class ShapeState {
   // and rebuilt from the collapsed edges left, placed again, and the faces around them priced
   // again. Returns the change (reduced < 0: the count grows).
   Move uncollapse(std::span<const Index> edges) {
+    Scratch& sc = main_;
     Move m;
-    ++token_;
+    ++sc.token;
     split_roots_.clear();
     split_members_.clear();
     for (Index e : edges) {
@@ -217,8 +258,8 @@ class ShapeState {
       }
       for (Index v : conn_.edge_vertices[e]) {
         const Index r = uf_.find(v);
-        if (root_token_[r] == token_) continue;
-        root_token_[r] = token_;
+        if (sc.root_token[r] == sc.token) continue;
+        sc.root_token[r] = sc.token;
         split_roots_.push_back(r);
       }
     }
@@ -229,13 +270,13 @@ class ShapeState {
       if (terms_[r].w > 0.0) m.peak2 = std::max(m.peak2, err_[r] / terms_[r].w);
       for_each_member(r, [&](Index v) { split_members_.push_back(v); });
     }
-    gather_faces([&](auto&& visit) {
+    gather_faces(sc, [&](auto&& visit) {
       for (Index v : split_members_) visit(v);
     });
     for (Index v : split_members_) {
       uf_.reset(v);
       next_member_[v] = v;
-      terms_[v] = base_terms_[v];
+      terms_[v] = vertex_alone(v);
       err_[v] = 0.0;
       pos_[v] = mesh_.positions[v];
     }
@@ -254,11 +295,11 @@ class ShapeState {
           const Index r = uf_.unite(ra, rb);
           terms_[r] = t;
         }
-    ++token_;
+    ++sc.token;
     for (Index v : split_members_) {
       const Index r = uf_.find(v);
-      if (root_token_[r] == token_) continue;
-      root_token_[r] = token_;
+      if (sc.root_token[r] == sc.token) continue;
+      sc.root_token[r] = sc.token;
       if (next_member_[r] == r) continue;  // a lone vertex: at its place, no error
       const ClusterPlacement pl = place_cluster(terms_[r], h_, params_.placement, [&](auto&& visit) {
         for_each_member(r, [&](Index w) { visit(mesh_.positions[w]); });
@@ -269,7 +310,7 @@ class ShapeState {
     }
     error_ += m.error;
     if (params_.lambda_shape > 0.0)
-      for (Index f : shape_faces_) {
+      for (Index f : sc.shape_faces) {
         const double p = penalty(f, face_kept_[f], [&](Index v) -> const Vec3& { return pos_[uf_.find(v)]; });
         m.shape += p - pen_[f];
         shape_ += p - pen_[f];
@@ -280,11 +321,12 @@ class ShapeState {
 
   // Applies the move last priced by evaluate().
   void apply(const Move& m) {
-    for (Index e : moved_edges_) kept_[e] = 0;
-    for (Index f : touched_faces_) face_kept_[f] -= face_removed_[f];
+    const Scratch& sc = main_;
+    for (Index e : sc.moved_edges) kept_[e] = 0;
+    for (Index f : sc.touched_faces) face_kept_[f] -= sc.face_removed[f];
     count_ -= m.reduced;
     error_ += m.error;
-    for (NewCluster& s : sets_) {
+    for (const NewCluster& s : sc.sets) {
       Index root = s.roots[0];
       for (std::size_t i = 1; i < s.roots.size(); ++i) {
         const Index joined = uf_.unite(root, s.roots[i]);
@@ -297,7 +339,7 @@ class ShapeState {
       pos_[root] = s.placement.position;
     }
     if (params_.lambda_shape > 0.0) {
-      for (Index f : shape_faces_) {
+      for (Index f : sc.shape_faces) {
         const double p = penalty(f, face_kept_[f], [&](Index v) -> const Vec3& { return pos_[uf_.find(v)]; });
         shape_ += p - pen_[f];
         pen_[f] = p;
@@ -306,11 +348,13 @@ class ShapeState {
   }
 
  private:
-  struct NewCluster {
-    ClusterTerms terms;
-    std::vector<Index> roots;
-    ClusterPlacement placement;
-  };
+  using NewCluster = Scratch::NewCluster;
+
+  ClusterTerms vertex_alone(Index v) const {
+    ClusterTerms t;
+    t.add_vertex(quadrics_->terms[v], mesh_.positions[v]);
+    return t;
+  }
 
   // Eq. 1: a face with `kept` kept edges counts max(0, kept − 2) triangle-equivalents.
   static std::int64_t tri_equivalents(Index kept) { return kept > 2 ? kept - 2 : 0; }
@@ -360,18 +404,18 @@ class ShapeState {
   }
 
   // Every face with a corner at a vertex that `for_each_vertex(visit)` visits, once, into
-  // shape_faces_.
+  // sc.shape_faces.
   template <class ForEachVertex>
-  void gather_faces(ForEachVertex&& for_each_vertex) {
-    ++face_tok2_;
-    if (face_token2_.size() != face_token_.size()) face_token2_.assign(face_token_.size(), 0);
-    shape_faces_.clear();
+  void gather_faces(Scratch& sc, ForEachVertex&& for_each_vertex) {
+    ++sc.face_tok2;
+    if (sc.face_token2.size() != sc.face_token.size()) sc.face_token2.assign(sc.face_token.size(), 0);
+    sc.shape_faces.clear();
     for_each_vertex([&](Index v) {
       for (Index c : conn_.corners_at_vertex(v)) {
         const Index f = conn_.corner_face[c];
-        if (face_token2_[f] == face_tok2_) continue;
-        face_token2_[f] = face_tok2_;
-        shape_faces_.push_back(f);
+        if (sc.face_token2[f] == sc.face_tok2) continue;
+        sc.face_token2[f] = sc.face_tok2;
+        sc.shape_faces.push_back(f);
       }
     });
   }
@@ -385,32 +429,16 @@ class ShapeState {
     } while (v != r);
   }
 
-  Index local_of(Index root) {
-    if (root_token_[root] != token_) {
-      root_token_[root] = token_;
-      root_local_[root] = Index(locals_.size());
-      locals_.push_back(root);
-      local_parent_.push_back(Index(local_parent_.size()));
-    }
-    return root_local_[root];
-  }
-  Index find_local(Index x) {
-    while (local_parent_[x] != x) x = local_parent_[x] = local_parent_[local_parent_[x]];
-    return x;
-  }
-  void unite_local(Index a, Index b) {
-    a = find_local(a);
-    b = find_local(b);
-    if (a != b) local_parent_[std::max(a, b)] = std::min(a, b);
-  }
-
   const PolyMesh& mesh_;
   const Connectivity& conn_;
   const ShapeSelectionParams& params_;
   UnionFind uf_;
   double h_ = 1.0, norm_ = 1.0;
   std::vector<ClusterTerms> terms_;  // per root
-  std::vector<ClusterTerms> base_terms_;  // per vertex alone
+  // The vertex quadrics the terms come from (a vertex alone: vertex_alone), borrowed or own;
+  // kept rather than a copy of every vertex's ClusterTerms (208 bytes a vertex, issue 20).
+  VertexQuadrics own_quadrics_;
+  const VertexQuadrics* quadrics_ = nullptr;
   std::vector<double> err_;          // per root
   std::vector<Vec3> pos_;            // per root
   std::vector<Index> next_member_;
@@ -422,12 +450,8 @@ class ShapeState {
   std::int64_t count_ = 0;
   double error_ = 0.0, shape_ = 0.0;
 
-  // Scratch of the last evaluate().
-  Index token_ = 0, face_tok2_ = 0;
-  std::vector<Index> root_token_, root_local_, face_token_, face_removed_, face_token2_;
-  std::vector<Index> locals_, local_parent_, set_of_, moved_edges_, touched_faces_, shape_faces_;
+  Scratch main_;  // of evaluate(edges), uncollapse() and apply()
   std::vector<Index> split_roots_, split_members_;
-  std::vector<NewCluster> sets_;
 };
 
 // A candidate of the greedy: a unit (segment) collapse, or a single edge collapse.
@@ -452,6 +476,30 @@ Band eq2_band(std::uint64_t target, double eps) {
 }
 
 }  // namespace
+
+// Runs work(begin, end, scratch) over [0, n) in contiguous chunks, one per thread; the calling
+// thread takes the first chunk with scratch nullptr (the state's own), the others each get one
+// from make_scratch(). One thread when n is below min_parallel (a thread and its scratch cost
+// more than they save on a small mesh).
+template <class Work, class MakeScratch>
+void parallel_chunks(std::size_t n, int threads, std::size_t min_parallel, Work&& work, MakeScratch&& make_scratch) {
+  std::size_t t = threads > 0 ? std::size_t(threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (n < min_parallel) t = 1;
+  t = std::max<std::size_t>(1, std::min(t, n));
+  if (t == 1) {
+    work(0, n, nullptr);
+    return;
+  }
+  std::vector<std::thread> pool;
+  const std::size_t chunk = (n + t - 1) / t;
+  for (std::size_t k = 1; k < t; ++k)
+    pool.emplace_back([&, k] {
+      auto scratch = make_scratch();
+      work(std::min(n, k * chunk), std::min(n, (k + 1) * chunk), &scratch);
+    });
+  work(0, std::min(n, chunk), nullptr);
+  for (std::thread& th : pool) th.join();
+}
 
 ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                      std::uint64_t target, const ShapeSelectionParams& params) {
@@ -506,18 +554,46 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     return per >= 0.0 ? per * handicap : per / handicap;
   };
 
-  std::priority_queue<Candidate> heap;
   std::int64_t version = 0;
-  auto consider = [&](Index id) {
-    const Move m = state.evaluate(move_edges(id));
-    ++st.evaluations;
-    if (m.reduced > 0 && m.valid) heap.push({priority(id, m), id, version});
-  };
-  for (Index u = 0; u < nu; ++u)
-    if (!units.g.fixed[u]) consider(u);
-  if (singles)
-    for (Index e = 0; e < conn.num_edges; ++e)
-      if (single_edge(e)) consider(nu + e);
+  // The first pricing of every candidate (units, then single edges, by id): each alone against
+  // the input state, so the threads share nothing but reads. The heap's pops depend only on the
+  // (priority, id) order, not on the order the candidates were found in.
+  std::vector<Candidate> first;
+  {
+    // Chunk [begin, end) writes its usable candidates from first[begin] on; the chunks are then
+    // closed up in order (one array, no per-thread copies: it is the peak of a 1M-face pass).
+    const std::size_t n = std::size_t(nu) + (singles ? conn.num_edges : 0);
+    first.resize(n);
+    std::vector<std::pair<std::size_t, std::size_t>> filled;  // per chunk: begin, end of its writes
+    std::mutex filled_mutex;
+    std::atomic<std::int64_t> evaluations = 0;
+    auto price = [&](std::size_t begin, std::size_t end, Scratch* scratch) {
+      std::size_t out = begin;
+      std::int64_t evaluated = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const Index id = Index(i);
+        if (id < nu ? bool(units.g.fixed[id]) : !single_edge(id - nu)) continue;
+        Index one = id >= nu ? id - nu : 0;
+        const std::span<const Index> edges = id < nu ? units.of(id) : std::span<const Index>(&one, 1);
+        const Move m = scratch ? state.evaluate(edges, *scratch) : state.evaluate(edges);
+        ++evaluated;
+        if (m.reduced > 0 && m.valid) first[out++] = {priority(id, m), id, version};
+      }
+      evaluations += evaluated;
+      std::lock_guard lock(filled_mutex);
+      filled.push_back({begin, out});
+    };
+    parallel_chunks(n, params.threads, params.min_parallel_candidates, price, [&] { return state.make_scratch(); });
+    std::sort(filled.begin(), filled.end());
+    std::size_t size = 0;
+    for (const auto& [begin, end] : filled) {
+      std::move(first.begin() + std::ptrdiff_t(begin), first.begin() + std::ptrdiff_t(end), first.begin() + std::ptrdiff_t(size));
+      size += end - begin;
+    }
+    first.resize(size);
+    st.evaluations += evaluations;
+  }
+  std::priority_queue<Candidate> heap(std::less<Candidate>(), std::move(first));
 
   while (state.count() > std::int64_t(target) && !heap.empty()) {
     const Candidate top = heap.top();

@@ -23,7 +23,8 @@
 // make triangles (as Single, Knodt 2025, does) compete too, handicapped by
 // triangle_collapse_factor and capped at max_triangle_share of the reduction.
 //
-// Deterministic: no clock, no threads, ties broken by id. The paper's Eq. 9 selection stays in
+// Deterministic: no clock, ties broken by id; the first pricing of every candidate runs on
+// `threads` threads, each candidate priced alone, so the result does not depend on them. The paper's Eq. 9 selection stays in
 // select_edges() (`--objective paper`).
 #pragma once
 
@@ -80,6 +81,12 @@ struct ShapeSelectionParams {
   /// At most this share of the reduction (input − N triangle-equivalents) comes from single
   /// collapses.
   double max_triangle_share = 0.4;
+  /// Threads of the first pricing of all candidates (the greedy itself is sequential); 0 = all
+  /// cores. Speed only: the selection is the same for any value.
+  int threads = 0;
+  /// Below this many candidates the first pricing runs on one thread (measured: on the 500-face
+  /// suzanne a second thread's start and scratch cost more than its share of the pricing).
+  std::size_t min_parallel_candidates = 20000;
 };
 
 struct ShapeSelectionStats {
