@@ -562,10 +562,17 @@ TEST(ClusterCollapseInvariants, RandomSelectionsGiveValidMeshes) {
           EXPECT_EQ(evaluate(nm.mesh, r.mesh, ep).flipped_faces, 0u);
           EXPECT_LE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_in);
           EXPECT_GE(r.stats.tri_equivalent_out, r.stats.tri_equivalent_wanted);
-          if (seed == 1) {  // deterministic
+          if (seed == 1) {  // deterministic, and the same when the face checks run on threads
             const ClusterCollapseResult again = collapse_clusters(nm.mesh, conn, kept, params);
             EXPECT_EQ(again.mesh.corner_vertex, r.mesh.corner_vertex);
             EXPECT_EQ(again.mesh.positions, r.mesh.positions);
+            ClusterCollapseParams threaded = params;
+            threaded.threads = 3;
+            threaded.min_parallel_faces = 0;
+            const ClusterCollapseResult par = collapse_clusters(nm.mesh, conn, kept, threaded);
+            EXPECT_EQ(par.mesh.corner_vertex, r.mesh.corner_vertex);
+            EXPECT_EQ(par.mesh.positions, r.mesh.positions);
+            EXPECT_EQ(par.stats.refused_tri_equivalents, r.stats.refused_tri_equivalents);
           }
         }
       }

@@ -546,6 +546,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   else shp.check_faces = false;
   shp.zero_area_epsilon = cp.zero_area_epsilon;
   cp.max_hausdorff = options.max_hausdorff;
+  cp.threads = options.threads;
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
   cp.features.hard_angle_deg = options.hard_angle_deg;

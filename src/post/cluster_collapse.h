@@ -78,6 +78,11 @@ struct ClusterCollapseParams {
   /// outlive the call); nullptr: built here. simplify() builds them once per pass for the shape
   /// selection and every collapse round of that pass.
   const VertexQuadrics* vertex_quadrics = nullptr;
+  /// Threads of the face checks of a round (each dirty face checked alone; the refusals are
+  /// replayed in face order, so the output does not depend on the count); 0 = all cores. A round
+  /// with fewer than min_parallel_faces dirty faces runs on one thread.
+  int threads = 0;
+  std::size_t min_parallel_faces = 20000;
 
   /// Clusters on hard edges (dihedral >= FeatureParams::hard_angle_deg, or smoothing groups) but
   /// on no other feature are placed on the hard line or at its corner (issue 7's rule) when true;

@@ -7,6 +7,7 @@
 #include "geometry/bvh.h"
 #include "mesh/union_find.h"
 #include "post/collapser.h"
+#include "util/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -38,7 +39,13 @@ inline Vec3 corner_turn(const Vec3& prev, const Vec3& cur, const Vec3& next) {
 
 // Face checks on every piece of a dirty face: degenerate, flipped, folded at a corner. The
 // reference is the input face the piece comes from (its normal and its corners' convexity).
-void Collapser::check_face(Index f) {
+// Reads the state only (so dirty faces are checked on several threads); the refusals go to
+// `found`, in the order blame() is to see them.
+void Collapser::check_face(Index f, std::vector<FaceBlame>& found) const {
+  auto blame = [&](Index r, CollapseRefusal why) { found.push_back({r, why}); };
+  auto blame_piece = [&](const Index* corners, Index len, CollapseRefusal why) {
+    for (Index i = 0; i < len; ++i) blame(root_of_corner(corners[i]), why);
+  };
   const bool input_flat = !(face_area_[f] > zero_area_);
   const Vec3& n_in = face_n_[f];
   Index off = piece_base(f);
@@ -443,7 +450,13 @@ void Collapser::check_hausdorff(Index v) {
 }
 
 void Collapser::check(const std::vector<Index>& dirty) {
-  for (Index f : dirty) check_face(f);
+  std::vector<std::vector<FaceBlame>> found(thread_count(params_.threads));
+  const std::size_t chunks = parallel_chunks(dirty.size(), params_.threads, params_.min_parallel_faces,
+                                             [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+                                               for (std::size_t i = begin; i < end; ++i) check_face(dirty[i], found[chunk]);
+                                             });
+  for (std::size_t k = 0; k < chunks; ++k)
+    for (const FaceBlame& b : found[k]) blame(b.root, b.why);
   // Vertices whose fan may have changed: every vertex of a dirty face (dropped faces included).
   ++vert_tok_;
   std::vector<Index> verts;

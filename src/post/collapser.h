@@ -69,7 +69,12 @@ class Collapser {
 
   // --- checks ----------------------------------------------------------------------------------
   void check(const std::vector<Index>& dirty);
-  void check_face(Index f);
+  // A refusal a face check found, replayed through blame() in the order of the dirty faces.
+  struct FaceBlame {
+    Index root;
+    CollapseRefusal why;
+  };
+  void check_face(Index f, std::vector<FaceBlame>& found) const;
   void check_vertex(Index v);
   void check_hausdorff(Index v);
   template <class PositionOf>

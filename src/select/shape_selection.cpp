@@ -15,6 +15,7 @@
 
 #include "mesh/union_find.h"
 #include "select/groups.h"
+#include "util/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,7 +25,6 @@
 #include <span>
 #include <atomic>
 #include <mutex>
-#include <thread>
 
 namespace quadlod {
 
@@ -477,30 +477,6 @@ Band eq2_band(std::uint64_t target, double eps) {
 
 }  // namespace
 
-// Runs work(begin, end, scratch) over [0, n) in contiguous chunks, one per thread; the calling
-// thread takes the first chunk with scratch nullptr (the state's own), the others each get one
-// from make_scratch(). One thread when n is below min_parallel (a thread and its scratch cost
-// more than they save on a small mesh).
-template <class Work, class MakeScratch>
-void parallel_chunks(std::size_t n, int threads, std::size_t min_parallel, Work&& work, MakeScratch&& make_scratch) {
-  std::size_t t = threads > 0 ? std::size_t(threads) : std::max(1u, std::thread::hardware_concurrency());
-  if (n < min_parallel) t = 1;
-  t = std::max<std::size_t>(1, std::min(t, n));
-  if (t == 1) {
-    work(0, n, nullptr);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const std::size_t chunk = (n + t - 1) / t;
-  for (std::size_t k = 1; k < t; ++k)
-    pool.emplace_back([&, k] {
-      auto scratch = make_scratch();
-      work(std::min(n, k * chunk), std::min(n, (k + 1) * chunk), &scratch);
-    });
-  work(0, std::min(n, chunk), nullptr);
-  for (std::thread& th : pool) th.join();
-}
-
 ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                                      std::uint64_t target, const ShapeSelectionParams& params) {
   ShapeSelectionResult out;
@@ -583,7 +559,11 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
       std::lock_guard lock(filled_mutex);
       filled.push_back({begin, out});
     };
-    parallel_chunks(n, params.threads, params.min_parallel_candidates, price, [&] { return state.make_scratch(); });
+    parallel_chunks(n, params.threads, params.min_parallel_candidates, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+      if (chunk == 0) return price(begin, end, nullptr);  // the state's own scratch
+      Scratch scratch = state.make_scratch();
+      price(begin, end, &scratch);
+    });
     std::sort(filled.begin(), filled.end());
     std::size_t size = 0;
     for (const auto& [begin, end] : filled) {
