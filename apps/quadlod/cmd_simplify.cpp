@@ -59,9 +59,14 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--shape-flip-angle", p.shape_flip_angle_deg,
                   "Shape greedy: skip moves that flip a face by more than this angle, degrees (0 = off)")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Objective");
-  sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget in seconds (0 = greedy selection only)")
+  sub->add_option("--effort", p.effort,
+                  "Work to spend (1 = default): shape plans effort x the passes (same output on any machine); paper scales its MIP budget")
+      ->check(CLI::Range(0.05, 20.0))->capture_default_str()->group("Solver");
+  auto* time_limit = sub->add_option("--time-limit", p.time_limit_seconds,
+                  "paper: MIP time budget in seconds (0 = greedy selection only); shape: an upper bound on the run (none unless given)")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Solver");
-  sub->add_option("--threads", p.threads, "Solver threads: CBC's tree search, and the threads of annealing runs in the fast selection (0 = all cores)")
+  sub->add_option("--threads", p.threads,
+                  "Threads (0 = all cores): speed only for shape; CBC's tree search and the annealing runs for paper")
       ->check(CLI::Range(0, 256))->capture_default_str()->group("Solver");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Solver");
   sub->add_option("--formulation", opt->formulation, "fast, or exact (the paper's model as written)")
@@ -116,11 +121,14 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
   sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
-  return {sub, [opt, ratio, faces, &global]() -> int {
+  return {sub, [opt, ratio, faces, time_limit, &global]() -> int {
             if (ratio->count() == 0 && faces->count() == 0) {
               std::fprintf(stderr, "quadlod simplify: give a target: --ratio R or --faces N\n");
               return kExitUsage;
             }
+            // The shape objective has no time budget: a given --time-limit bounds its run.
+            if (time_limit->count() > 0 && opt->pipeline.objective == "shape")
+              opt->pipeline.time_bound_seconds = opt->pipeline.time_limit_seconds;
             for (const std::string& out : {opt->output, opt->report})
               if (!out.empty() && same_file(opt->input, out))
                 return fail(out + ": refusing to overwrite the input");

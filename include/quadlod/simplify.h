@@ -57,9 +57,22 @@ struct SimplifyOptions {
   /// (measured worse: docs/shape_objective.md).
   double shape_flip_angle_deg = 0.0;
 
+  // --- effort and time (issue 20) ---------------------------------------------------------------
+  /// How much work to spend, > 0; 1 = the measured default. The shape objective plans `effort`
+  /// times the passes (pass ratio 0.9^(1/effort), at most 32 · effort passes; an explicit
+  /// pass_ratio / max_passes wins): the output depends on the input and options only. The paper
+  /// objective multiplies its MIP time budget by it.
+  double effort = 1.0;
+  /// Shape objective: an optional upper bound on the run's wall time, seconds (0 = none, the
+  /// default). Once a pass ends past it, the next pass aims at the target and is the last planned
+  /// one (report: time_bound_reached); only then does the output depend on the clock.
+  double time_bound_seconds = 0.0;
+
   // --- solver (objective "paper") --------------------------------------------------------------
-  double time_limit_seconds = 5.0;  ///< MIP time budget; 0 = greedy selection only
-  int threads = 0;                  ///< solver threads (CBC; annealing runs of the fast selection); 0 = all cores
+  double time_limit_seconds = 5.0;  ///< MIP time budget (objective "paper"); 0 = greedy selection only
+  /// Threads: the shape greedy's first pricing and the collapse's face checks (the output is the
+  /// same for any count), CBC and the annealing runs of the paper objective; 0 = all cores.
+  int threads = 0;
   std::uint32_t seed = 1;
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
   /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).

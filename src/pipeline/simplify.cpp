@@ -13,6 +13,7 @@
 #include "util/progress.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -483,11 +484,22 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     result.error = "the target ratio must be in (0, 1]";
     return result;
   }
-  const double pass_ratio = options.pass_ratio < 0.0 ? default_pass_ratio(options.objective) : options.pass_ratio;
+  if (!(options.effort > 0.0) || !std::isfinite(options.effort)) {
+    result.error = "the effort must be a positive number";
+    return result;
+  }
+  // Effort (issue 20): the work, not the clock. The shape objective spends it on passes: effort
+  // E plans E times the passes of the default ratio (pass ratio r^(1/E)), each re-reading the
+  // layout; docs/shape_objective.md ("Effort") has the measured trade-off.
+  const double effort = options.effort;
+  const double pass_ratio = options.pass_ratio >= 0.0 ? options.pass_ratio
+                            : options.objective == "shape" ? std::pow(default_pass_ratio(options.objective), 1.0 / effort)
+                                                           : default_pass_ratio(options.objective);
   if (!(pass_ratio > 0.0 && pass_ratio < 1.0)) {
     result.error = "the pass ratio must be in (0, 1)";
     return result;
   }
+  const auto started = std::chrono::steady_clock::now();
   StageLog log(options.progress);
   nlohmann::json& report = result.report;
 
@@ -570,11 +582,15 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   // round_tolerance, further passes aim at N directly while they get closer, up to max_passes.
   // docs/formulation.md ("Passes") has the measurements.
   const double n0 = double(result.input_tri_equivalent), n = double(result.target);
-  const int max_passes = std::max(1, options.max_passes < 0 ? default_max_passes(options.objective) : options.max_passes);
+  const int max_passes = std::max(1, options.max_passes >= 0 ? options.max_passes
+                                     : options.objective == "shape" ? int(std::ceil(default_max_passes(options.objective) * effort))
+                                                                    : default_max_passes(options.objective));
   int planned = 1;
   if (n < n0 && n > 0.0)
     planned = std::clamp(static_cast<int>(std::ceil(std::log(n / n0) / std::log(pass_ratio) - 1e-9)), 1, max_passes);
-  const double pass_time = options.time_limit_seconds / planned;
+  // The paper objective's search is clock-driven: effort scales its MIP budget.
+  const double pass_time = options.time_limit_seconds * (options.objective == "shape" ? 1.0 : effort) / planned;
+  bool time_bound_reached = false;
   // Every pass checks orientation against the original input surface (docs/metrics.md §6b) ...
   std::optional<SurfaceReference> surface;
   if (cp.check_surface_orientation) {
@@ -599,6 +615,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   nlohmann::json passes = nlohmann::json::array();
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
   for (int pass = 1; pass <= max_passes; ++pass) {
+    // An upper bound on the run (optional; the output then depends on the clock): once reached,
+    // this pass aims at N itself and is the last planned one.
+    if (options.time_bound_seconds > 0.0 && pass > 1 && pass < planned &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() > options.time_bound_seconds) {
+      planned = pass;
+      time_bound_reached = true;
+    }
     const std::uint64_t pass_target =
         pass < planned ? static_cast<std::uint64_t>(std::llround(n0 * std::pow(n / n0, double(pass) / planned)))
                        : result.target;
@@ -647,6 +670,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     if (last.report.contains(key)) report[key] = last.report[key];
   report["passes"] = std::move(passes);
   report["passes_planned"] = planned;
+  report["time_bound_reached"] = time_bound_reached;
   report["stage_seconds"] = {{"analysis", seconds_analysis},
                              {"select", seconds_select},
                              {"dual", seconds_dual},
@@ -760,6 +784,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},
       {"pass_ratio", pass_ratio},
+      {"effort", effort},
+      {"time_bound_seconds", options.time_bound_seconds},
       {"max_passes", max_passes},
       {"greedy_fallback", options.greedy_fallback},
       {"objective", options.objective},
