@@ -15,7 +15,6 @@ import traceback
 
 import bpy
 
-zip_path = sys.argv[sys.argv.index("--") + 1]
 failures = []
 
 
@@ -28,6 +27,14 @@ def check(condition, what):
 def counts(mesh):
     sizes = [p.loop_total for p in mesh.polygons]
     return dict(faces=len(sizes), quads=sum(k == 4 for k in sizes), tri_equivalent=sum(k - 2 for k in sizes))
+
+
+def mesh_dict(mesh):
+    from quadlod.blender_addon import _mesh_arrays
+
+    a = _mesh_arrays(mesh)
+    return dict(vertices=a["vertices"], faces=a["faces"][0], face_sizes=a["faces"][1], uvs=a["uvs"],
+                materials=a["materials"])
 
 
 def make_test_object():
@@ -45,7 +52,7 @@ def make_test_object():
     return obj
 
 
-def main():
+def main(zip_path):
     bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
     bpy.ops.preferences.addon_enable(module="quadlod")
     import quadlod
@@ -81,7 +88,8 @@ def main():
         check([layer.name for layer in lod.data.uv_layers] == [layer.name for layer in obj.data.uv_layers],
               f"LOD{k}: UV layers {[layer.name for layer in lod.data.uv_layers]}")
         uv = lod.data.uv_layers[0].data if lod.data.uv_layers else []
-        check(len(uv) == len(lod.data.loops) and all(0 <= d.uv.x <= 1 and 0 <= d.uv.y <= 1 for d in uv),
+        eps = 1e-6  # UVs are re-projected within their chart: they stay in the input's [0, 1] square
+        check(len(uv) == len(lod.data.loops) and all(-eps <= d.uv.x <= 1 + eps and -eps <= d.uv.y <= 1 + eps for d in uv),
               f"LOD{k}: one UV per loop, inside the input's [0, 1] range")
         check([m.name for m in lod.data.materials] == ["Red", "Blue"], f"LOD{k}: material slots Red, Blue")
         used = {p.material_index for p in lod.data.polygons}
@@ -91,6 +99,10 @@ def main():
         check(wrong == 0, f"LOD{k}: {wrong} faces on the wrong side of the material border")
         check("Upper" in lod.vertex_groups, f"LOD{k}: vertex group carried")
         check(lod.matrix_world == obj.matrix_world, f"LOD{k}: same transform as the source")
+        # The module's own metrics on the Blender meshes: no seam torn, no two UV islands merged.
+        metrics = quadlod.evaluate(mesh_dict(obj.data), mesh_dict(lod.data), samples=20000)
+        check(metrics["seams_torn"] == 0 and metrics["uv_islands_merged"] == 0,
+              f"LOD{k}: {metrics['seams_torn']} seams torn, {metrics['uv_islands_merged']} UV islands merged")
 
     # A mesh without faces: an error report and a cancelled operator, Blender goes on.
     empty_mesh = bpy.data.meshes.new("Empty")
@@ -109,11 +121,12 @@ def main():
           "no LOD object made for the refused mesh")
 
 
-try:
-    main()
-except Exception:
-    traceback.print_exc()
-    failures.append("exception")
-print(f"test_addon: {len(failures)} failure(s)")
-if failures:
-    sys.exit(1)
+if __name__ == "__main__":  # screenshot_panel.py imports make_test_object only
+    try:
+        main(sys.argv[sys.argv.index("--") + 1])
+    except Exception:
+        traceback.print_exc()
+        failures.append("exception")
+    print(f"test_addon: {len(failures)} failure(s)")
+    if failures:
+        sys.exit(1)

@@ -48,7 +48,7 @@ def _settings_annotations():
                         "(off: the paper's behaviour, features only weigh in the error)",
             default=True),
         effort=EnumProperty(name="Effort", items=EFFORT_ITEMS, default="DEFAULT"),
-        time_limit=FloatProperty(name="Time limit (s)", description="MIP budget per level (effort ILP)",
+        time_limit=FloatProperty(name="Time limit (s)", description="MIP budget per level in seconds (effort ILP)",
                                  default=5.0, min=0.0, max=600.0),
     )
 
@@ -325,9 +325,8 @@ class QUADLOD_PT_panel(bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         settings = context.scene.quadlod
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        layout.prop(settings, "target_mode", expand=True)
+        # No property split: the sidebar is narrow and split labels get cut off.
+        layout.row().prop(settings, "target_mode", expand=True)
         if settings.target_mode == "COUNT":
             layout.prop(settings, "target_triangles")
         layout.prop(settings, "ratio")
