@@ -6,7 +6,8 @@
    configuration is never touched;
 2. where Xvfb is present, Blender with its UI under Xvfb runs tests/blender/screenshot_panel.py,
    which opens the add-on's sidebar panel and saves a screenshot (docs/blender_panel.png is a
-   copy of it); the step fails if no non-blank PNG appears.
+   copy of it), then runs the operator as the UI does (modal) and checks one undo step removes
+   its LODs and redo restores them; the step fails on a failed check or a blank screenshot.
 """
 
 import argparse
@@ -68,7 +69,7 @@ def main() -> int:
                          "--python", str(HERE / "screenshot_panel.py"), "--", args.zip, str(shot)],
                         env=env, capture_output=True, text=True, timeout=300)
     print(ui.stdout[-5000:])
-    if ui.returncode != 0 or not shot.exists():
+    if ui.returncode != 0 or not shot.exists() or "screenshot_panel: 0 failure(s)" not in ui.stdout:
         print(ui.stderr[-5000:], file=sys.stderr)
         print(f"panel screenshot failed (exit {ui.returncode})")
         return 1

@@ -5,7 +5,9 @@
 Installs and enables the add-on, makes the test torus of test_addon.py, runs the operator, puts
 the LODs beside the original, opens the sidebar on the "quadlod" tab (a simulated click on the tab:
 Blender 3.4 has no API for the active tab) and saves a screenshot
-of the 3D view area. Run by tests/blender/run_blender_tests.py.
+of the 3D view area. Then what only a UI session can show: the operator invoked (modal, one LOD
+level per timer tick) on a second mesh, and one undo step removing what it made. Run by
+tests/blender/run_blender_tests.py.
 """
 
 import sys
@@ -53,6 +55,8 @@ def prepare():
     view.view_location = Vector((2.8, 0.0, 0.0))  # the middle of original, LOD1, LOD2
     view.view_rotation = Euler((0.75, 0.0, 0.0)).to_quaternion()
     view.view_distance = 8.5
+    # Operators called from timers push no undo step of their own: mark this state explicitly.
+    bpy.ops.ed.undo_push(message="test scene")
     return 1.0
 
 
@@ -85,11 +89,67 @@ def screenshot():
     with bpy.context.temp_override(window=window, area=area):
         bpy.ops.screen.screenshot_area(filepath=png_path)
     print(f"screenshot_panel: wrote {png_path}")
+    return 0.2
+
+
+failures = []
+
+
+def check(condition, what):
+    print(("ok   " if condition else "FAIL ") + what)
+    if not condition:
+        failures.append(what)
+
+
+def invoke_modal():
+    """The operator as the UI runs it (INVOKE: modal, one level per timer tick, status bar text)."""
+    bpy.ops.mesh.primitive_cylinder_add(vertices=32, depth=2.0, location=(0, 4, 0))
+    cylinder = bpy.context.active_object
+    cylinder.name = "Tube"
+    bpy.ops.object.select_all(action="DESELECT")
+    cylinder.select_set(True)
+    bpy.context.view_layer.objects.active = cylinder
+    bpy.ops.ed.undo_push(message="tube added")
+    window, area = view3d()
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    with bpy.context.temp_override(window=window, area=area, region=region):
+        result = bpy.ops.object.quadlod_lod("INVOKE_DEFAULT", levels=2, ratio=0.6)
+    check(result == {"RUNNING_MODAL"}, f"invoked operator runs modal ({result})")
+    return 3.0
+
+
+def after_modal():
+    coll = bpy.data.collections.get("Tube_LODs")
+    names = sorted(o.name for o in coll.objects) if coll else []
+    check(names == ["Tube_LOD1", "Tube_LOD2"], f"modal run made Tube_LOD1, Tube_LOD2 ({names})")
+    window, area = view3d()
+    with bpy.context.temp_override(window=window, area=area):
+        bpy.ops.ed.undo()
+    return 1.0
+
+
+def after_undo():
+    check("Tube_LOD1" not in bpy.data.objects and "Tube_LOD2" not in bpy.data.objects,
+          "one undo step removes the LODs of the modal run")
+    check("Tube" in bpy.data.objects and "Ring_LOD1" in bpy.data.objects,
+          f"undo leaves the rest ({sorted(o.name for o in bpy.data.objects)})")
+    window, area = view3d()
+    with bpy.context.temp_override(window=window, area=area):
+        bpy.ops.ed.redo()
+    return 1.0
+
+
+def after_redo():
+    check("Tube_LOD1" in bpy.data.objects and "Tube_LOD2" in bpy.data.objects,
+          "redo brings them back: the operator pushed its own undo step")
+    print(f"screenshot_panel: {len(failures)} failure(s)")
+    if failures:
+        sys.exit(1)
     bpy.ops.wm.quit_blender()
     return None
 
 
-steps = [close_splash, prepare, switch_tab, screenshot]
+steps = [close_splash, prepare, switch_tab, screenshot, invoke_modal, after_modal, after_undo, after_redo]
 
 
 def run_next():
