@@ -120,6 +120,14 @@ def main(zip_path):
     check("Empty_LODs" not in bpy.data.collections or not bpy.data.collections["Empty_LODs"].objects,
           "no LOD object made for the refused mesh")
 
+    # Installing the zip again over the enabled add-on (an update) must not crash the session:
+    # Blender rewrites the installed files in place, so the extension runs from a private copy.
+    bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    bpy.ops.object.select_all(action="DESELECT")
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    check(bpy.ops.object.quadlod_lod(levels=1) == {"FINISHED"}, "operator runs after re-installing the zip")
+
 
 if __name__ == "__main__":  # screenshot_panel.py imports make_test_object only
     try:

@@ -18,7 +18,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import _core
+from . import _core  # the package loaded it (see _load_core in __init__.py)
 
 EFFORT_ITEMS = [
     ("FAST", "Fast", "Shape objective, greedy only (no exchange rounds, one selection round)"),
