@@ -55,7 +55,7 @@ std::string base64(const std::vector<T>& values) {
   return base64(values.data(), values.size() * sizeof(T));
 }
 
-/// Text placed inside <script> must neither close it nor open an HTML comment: "</script" →
+/// JavaScript placed inside <script> must neither close it nor open an HTML comment: "</script" →
 /// "<\/script", "<!--" → "<\!--" (the same string in JS and JSON literals, where these can occur).
 std::string script_safe(std::string_view text) {
   std::string out;
@@ -69,6 +69,18 @@ std::string script_safe(std::string_view text) {
       for (char& c : word) c = char(std::tolower(static_cast<unsigned char>(c)));
       if (word == "script") out += '\\';
     }
+  }
+  return out;
+}
+
+/// JSON placed inside <script>: every '<' (they occur only inside strings) as \u003c, which
+/// closes nothing, opens no comment and is the same string to JSON.parse.
+std::string json_script_safe(const std::string& json) {
+  std::string out;
+  out.reserve(json.size());
+  for (char c : json) {
+    if (c == '<') out += "\\u003c";
+    else out += c;
   }
   return out;
 }
@@ -304,7 +316,7 @@ HtmlReportResult build_html_report(const HtmlReportColumn& input, const std::vec
           std::to_string(params.eval.seed) + " (docs/metrics.md). Heat map: each output vertex's distance to the "
           "input surface, scale 0 to " + number(heat_max, "%.3e") + " (" +
           number(100 * params.heat_quantile, "%.0f") + "th percentile; largest " + number(heat_top, "%.3e") + ").</p>\n";
-  html += "<script type=\"application/json\" id=\"quadlod-data\">" + script_safe(data.dump()) + "</script>\n";
+  html += "<script type=\"application/json\" id=\"quadlod-data\">" + json_script_safe(data.dump()) + "</script>\n";
   html += "<script type=\"text/plain\" id=\"three-src\">";
   html += script_safe(asset(quadlod_asset_three_js, quadlod_asset_three_js_size));
   html += "</script>\n<script type=\"module\">\n";
