@@ -56,7 +56,7 @@ std::string base64(const std::vector<T>& values) {
 }
 
 /// JavaScript placed inside <script> must neither close it nor open an HTML comment: "</script" →
-/// "<\/script", "<!--" → "<\!--" (the same string in JS and JSON literals, where these can occur).
+/// "<\/script", "<!--" → "<\!--" (the same text to JS string and regex literals, where these occur).
 std::string script_safe(std::string_view text) {
   std::string out;
   out.reserve(text.size());
