@@ -104,6 +104,24 @@ def main(zip_path):
         check(metrics["seams_torn"] == 0 and metrics["uv_islands_merged"] == 0,
               f"LOD{k}: {metrics['seams_torn']} seams torn, {metrics['uv_islands_merged']} UV islands merged")
 
+    # Custom split normals travel: a cylinder with custom normals (all pointing up, so they are
+    # recognisably not the ones Blender would compute) gets LODs with custom normals pointing up.
+    bpy.ops.mesh.primitive_cylinder_add(vertices=24, depth=1.0, location=(0, 0, 5))
+    tube = bpy.context.active_object
+    tube.data.use_auto_smooth = True
+    tube.data.normals_split_custom_set([(0.0, 0.0, 1.0)] * len(tube.data.loops))
+    check(tube.data.has_custom_normals, "test cylinder has custom normals")
+    bpy.ops.object.select_all(action="DESELECT")
+    tube.select_set(True)
+    bpy.context.view_layer.objects.active = tube
+    check(bpy.ops.object.quadlod_lod(levels=1, ratio=0.6) == {"FINISHED"}, "operator on the custom-normal mesh")
+    lod = bpy.data.objects.get(tube.name + "_LOD1")
+    check(lod is not None and lod.data.has_custom_normals, "LOD keeps custom split normals")
+    if lod is not None:
+        lod.data.calc_normals_split()
+        up = sum(1 for loop in lod.data.loops if loop.normal.z > 0.99)
+        check(up == len(lod.data.loops), f"LOD normals are the custom ones ({up} of {len(lod.data.loops)} point up)")
+
     # A mesh without faces: an error report and a cancelled operator, Blender goes on.
     empty_mesh = bpy.data.meshes.new("Empty")
     empty_mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])

@@ -225,8 +225,10 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
             arrays = _mesh_arrays(obj.data)
             if len(arrays["faces"][1]) == 0:
                 raise _core.QuadlodError(f"{obj.name}: the mesh has no faces")
-            state = dict(arrays=arrays, previous=None, weights=_vertex_weights(obj),
-                         positions=[tuple(v) for v in arrays["vertices"]],
+            weights = _vertex_weights(obj)
+            state = dict(arrays=arrays, previous=None, weights=weights,
+                         # only the vertex-group transfer needs the source positions as tuples
+                         positions=[tuple(v) for v in arrays["vertices"]] if weights else None,
                          size=int(np.sum(arrays["faces"][1] - 2)),
                          all_smooth=all(p.use_smooth for p in obj.data.polygons),
                          collection=_lod_collection(context, f"{obj.name}_LODs"))
