@@ -116,9 +116,19 @@ void set_target(SimplifyOptions& options, const py::object& ratio, const py::obj
   if (!ratio.is_none() && !faces_target.is_none())
     throw py::value_error("give ratio or faces_target, not both");
   if (ratio.is_none() && faces_target.is_none()) throw py::value_error("give a target: ratio=R or faces_target=N");
-  if (!ratio.is_none()) options.ratio = ratio.cast<double>();
-  else {
-    const long long n = faces_target.cast<long long>();
+  if (!ratio.is_none()) {
+    try {
+      options.ratio = ratio.cast<double>();
+    } catch (const py::cast_error&) {
+      throw py::type_error("ratio: a number in (0, 1]");
+    }
+  } else {
+    long long n = 0;
+    try {
+      n = faces_target.cast<long long>();
+    } catch (const py::cast_error&) {
+      throw py::type_error("faces_target: an integer (triangle-equivalents)");
+    }
     if (n < 1) throw py::value_error("faces_target: must be >= 1 (triangle-equivalents: quad = 2, k-gon = k - 2)");
     options.ratio = 1.0;
     options.target_tri_equivalent = static_cast<std::uint64_t>(n);

@@ -155,6 +155,10 @@ def test_errors_are_exceptions_with_the_library_message():
         quadlod.simplify(vertices, quads)
     with pytest.raises(ValueError, match="ratio"):
         quadlod.simplify(vertices, quads, ratio=1.5)
+    with pytest.raises(TypeError, match="faces_target: an integer"):
+        quadlod.simplify(vertices, quads, faces_target="many")
+    with pytest.raises(TypeError, match="option 'seed': wrong type"):
+        quadlod.simplify(vertices, quads, ratio=0.5, seed="x")
     with pytest.raises(TypeError, match="unknown option 'no_such_option'"):
         quadlod.simplify(vertices, quads, ratio=0.5, no_such_option=1)
     assert issubclass(quadlod.QuadlodError, ValueError)
