@@ -201,3 +201,27 @@ def test_read_errors_carry_the_cli_message(tmp_path):
     with pytest.raises(quadlod.QuadlodError) as error:
         quadlod.read_mesh(str(broken))
     assert cli.stderr.strip() == "quadlod: " + str(error.value)
+
+
+CORPUS = os.environ.get("QUADLOD_CORPUS_DIR", "")
+
+
+@pytest.mark.skipif(not CLI, reason="QUADLOD_CLI not set (CTest sets it)")
+@pytest.mark.parametrize("name", ["collada_duck", "flightgear_head_amelia"])
+def test_same_output_as_the_cli_on_corpus_meshes_with_uvs(tmp_path, name):
+    """Corpus meshes with UVs (and the duck's normals): OBJ's shared UV / normal pools become one
+    entry per corner in the module, and the output is still the CLI's, UVs included."""
+    source = os.path.join(CORPUS, name + ".obj")
+    if not os.path.exists(source):
+        pytest.skip(f"{source} not present (../shared/corpus)")
+    reduced = tmp_path / "out.obj"
+    subprocess.run([CLI, "-q", "simplify", source, "-o", str(reduced), "--ratio", "0.5"], check=True, capture_output=True)
+    m = quadlod.read_mesh(source)
+    r = quadlod.simplify(m["vertices"], (m["faces"], m["face_sizes"]), ratio=0.5, uvs=m.get("uvs"),
+                         normals=m.get("normals"))
+    expected = quadlod.read_mesh(str(reduced))
+    np.testing.assert_array_equal(r["faces"], expected["faces"])
+    np.testing.assert_array_equal(r["face_sizes"], expected["face_sizes"])
+    np.testing.assert_allclose(r["vertices"], expected["vertices"], rtol=0, atol=1e-6)
+    (got,), (want,) = r["uvs"].values(), expected["uvs"].values()
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-6)
