@@ -305,6 +305,7 @@ HtmlReportResult build_html_report(const HtmlReportColumn& input, const std::vec
           "<label><input type=\"checkbox\" id=\"show-wire\" checked> wireframe</label>\n"
           "<label><input type=\"checkbox\" id=\"show-chords\"> poly-chords</label>\n"
           "<label><input type=\"checkbox\" id=\"show-heat\"> distance to the input</label>\n"
+          "<label><input type=\"checkbox\" id=\"z-up\"> Z up</label>\n"
           "<button id=\"reset-view\">reset view</button>\n"
           "<span class=\"hint\">drag: rotate · shift/right-drag: pan · wheel: zoom — all views move together</span>\n"
           "</header>\n<div id=\"views\"><canvas id=\"canvas\"></canvas><div id=\"labels\"></div></div>\n"

@@ -134,8 +134,9 @@ def main():
     if refused.returncode != 2 or "refusing to overwrite an input" not in refused.stderr:
         failures.append(f"report -o INPUT: exit {refused.returncode}, {refused.stderr.strip()}")
 
-    # The chain's screenshot shows the overlays (report.html#heat,chords): docs/report.png.
-    for page, columns, fragment in ((single, 1, ""), (chain, 2, "#heat,chords")):
+    # The chain's screenshot shows the overlays, the vase standing (report.html#heat,chords,zup):
+    # docs/report.png.
+    for page, columns, fragment in ((single, 1, ""), (chain, 2, "#heat,chords,zup")):
         text = page.read_text(encoding="utf-8")
         check_self_contained(text, page.name)
         heads = re.search(r'<table id="metrics"><thead><tr>(.*?)</tr>', text).group(1)

@@ -105,11 +105,13 @@ function buildView(column) {
 
   const scene = new THREE.Scene();
   scene.background = BACKGROUND;
-  scene.add(surface, wire, chords);
+  const model = new THREE.Group();  // rotated as a whole by the "Z up" switch
+  model.add(surface, wire, chords);
+  scene.add(model);
   scene.add(new THREE.HemisphereLight(0xffffff, 0x8a8a80, 1.6));
   const light = new THREE.DirectionalLight(0xffffff, 1.4);  // a headlight: follows the camera
   scene.add(light, light.target);
-  return { column, scene, surface, wire, chords, light, kindColour, heatColours, hasHeat: !!heat };
+  return { column, scene, model, surface, wire, chords, light, kindColour, heatColours, hasHeat: !!heat };
 }
 
 const views = data.columns.map(buildView);
@@ -163,7 +165,9 @@ function applyToggles() {
   const wire = document.getElementById('show-wire').checked;
   const chords = document.getElementById('show-chords').checked;
   const heat = document.getElementById('show-heat').checked;
+  const zUp = document.getElementById('z-up').checked;
   for (const v of views) {
+    v.model.rotation.x = zUp ? -Math.PI / 2 : 0;  // Z-up files (CAD, Blender's own axes) stand upright
     v.wire.visible = wire;
     v.chords.visible = chords;
     const colours = heat && v.hasHeat ? v.heatColours : v.kindColour;
@@ -174,7 +178,7 @@ function applyToggles() {
   drawLegend();
   requestRender();
 }
-for (const id of ['show-wire', 'show-chords', 'show-heat']) document.getElementById(id).addEventListener('change', applyToggles);
+for (const id of ['show-wire', 'show-chords', 'show-heat', 'z-up']) document.getElementById(id).addEventListener('change', applyToggles);
 document.getElementById('reset-view').addEventListener('click', () => { resetView(); requestRender(); });
 
 function layout() {
@@ -266,10 +270,11 @@ canvas.addEventListener('wheel', (e) => {
 }, { passive: false });
 window.addEventListener('resize', () => { layout(); requestRender(); });
 
-// report.html#heat,chords,nowire opens with those switches set (links, screenshots).
+// report.html#heat,chords,nowire,zup opens with those switches set (links, screenshots).
 const flags = new Set(location.hash.slice(1).split(','));
 if (flags.has('heat')) document.getElementById('show-heat').checked = true;
 if (flags.has('chords')) document.getElementById('show-chords').checked = true;
 if (flags.has('nowire')) document.getElementById('show-wire').checked = false;
+if (flags.has('zup')) document.getElementById('z-up').checked = true;
 layout();
 applyToggles();
