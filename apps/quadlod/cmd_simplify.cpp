@@ -4,6 +4,9 @@
 #include "quadlod/io.h"
 #include "quadlod/simplify.h"
 #include "util/progress.h"
+#ifdef QUADLOD_HTML_REPORT
+#include "report_html.h"
+#endif
 
 #include <cstdio>
 #include <memory>
@@ -13,7 +16,7 @@ namespace quadlod::cli {
 namespace {
 
 struct SimplifyCliOptions {
-  std::string input, output, report;
+  std::string input, output, report, report_html;
   double ratio = 0.0;
   std::uint64_t faces = 0;
   SimplifyOptions pipeline;
@@ -121,6 +124,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
   sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
+#ifdef QUADLOD_HTML_REPORT
+  sub->add_option("--report-html", opt->report_html,
+                  "Write the visual report of this run (as `quadlod report INPUT OUTPUT`)");
+#endif
   return {sub, [opt, ratio, faces, time_limit, &global]() -> int {
             if (ratio->count() == 0 && faces->count() == 0) {
               std::fprintf(stderr, "quadlod simplify: give a target: --ratio R or --faces N\n");
@@ -129,11 +136,14 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             // The shape objective has no time budget: a given --time-limit bounds its run.
             if (time_limit->count() > 0 && opt->pipeline.objective == "shape")
               opt->pipeline.time_bound_seconds = opt->pipeline.time_limit_seconds;
-            for (const std::string& out : {opt->output, opt->report})
+            for (const std::string& out : {opt->output, opt->report, opt->report_html})
               if (!out.empty() && same_file(opt->input, out))
                 return fail(out + ": refusing to overwrite the input");
             if (!opt->report.empty() && same_file(opt->output, opt->report))
               return fail(opt->report + ": the report and the output are the same file");
+            if (!opt->report_html.empty() &&
+                (same_file(opt->output, opt->report_html) || (!opt->report.empty() && same_file(opt->report, opt->report_html))))
+              return fail(opt->report_html + ": the HTML report and another output are the same file");
             MeshFormat format;
             if (!format_from_path(opt->output, format))
               return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
@@ -171,6 +181,17 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
               const WriteResult rep = write_file_atomically(opt->report, r.report.dump(2) + "\n");
               if (!rep.ok()) return fail(rep.error);
             }
+#ifdef QUADLOD_HTML_REPORT
+            if (!opt->report_html.empty()) {
+              HtmlReportParams html;
+              html.title = "quadlod simplify: " + file_label(opt->input) + " → " + file_label(opt->output);
+              html.progress = !global.quiet;
+              if (int code = write_html_report(opt->report_html, {file_label(opt->input), &in.mesh},
+                                               {{file_label(opt->output), &r.mesh}}, html);
+                  code != kExitOk)
+                return code;
+            }
+#endif
             const auto& rep = r.report;
             std::printf(
                 "simplify: target %llu, achieved %llu (%+.1f%%), %u quads, %u tris, %u n-gons; "

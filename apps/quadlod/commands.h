@@ -34,6 +34,9 @@ Command add_eval(CLI::App& app, const GlobalOptions& global);
 Command add_generate(CLI::App& app, const GlobalOptions& global);
 Command add_simplify(CLI::App& app, const GlobalOptions& global);
 Command add_analyze(CLI::App& app, const GlobalOptions& global);
+#ifdef QUADLOD_HTML_REPORT
+Command add_report(CLI::App& app, const GlobalOptions& global);
+#endif
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

@@ -35,6 +35,9 @@ int main(int argc, char** argv) {
       add_eval(app, global),
       add_analyze(app, global),
       add_generate(app, global),
+#ifdef QUADLOD_HTML_REPORT
+      add_report(app, global),
+#endif
   };
 
   try {

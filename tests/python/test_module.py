@@ -1,0 +1,227 @@
+"""The quadlod Python module (issue 22): arrays in and out, the CLI's answers, errors as exceptions.
+
+Run by CTest (test `python_module`) with PYTHONPATH=build/python and QUADLOD_CLI set; by hand:
+  PYTHONPATH=build/python QUADLOD_CLI=build/quadlod /usr/bin/python3 -m pytest tests/python
+"""
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import quadlod
+
+CLI = os.environ.get("QUADLOD_CLI")
+
+
+def torus(n=24, m=12, major=1.0, minor=0.35):
+    """An n × m all-quad torus with per-corner UVs (a seam along u = 0 and v = 0) and two
+    materials (the faces of the first half of the rings use slot 0, the rest slot 1)."""
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    u, v = 2 * np.pi * i / n, 2 * np.pi * j / m
+    vertices = np.stack([(major + minor * np.cos(v)) * np.cos(u),
+                         (major + minor * np.cos(v)) * np.sin(u),
+                         minor * np.sin(v)], axis=-1).reshape(-1, 3)
+    vid = lambda a, b: (a % n) * m + (b % m)  # noqa: E731
+    quads, uvs = [], []
+    for a in range(n):
+        for b in range(m):
+            quads.append([vid(a, b), vid(a + 1, b), vid(a + 1, b + 1), vid(a, b + 1)])
+            uvs.extend([(a / n, b / m), ((a + 1) / n, b / m), ((a + 1) / n, (b + 1) / m), (a / n, (b + 1) / m)])
+    quads = np.array(quads, dtype=np.int64)
+    materials = (np.arange(n * m) // m >= n // 2).astype(np.int32)
+    return vertices, quads, np.array(uvs), materials
+
+
+def tri_equivalents(sizes):
+    return int(np.sum(np.asarray(sizes) - 2))
+
+
+def check_layout(result):
+    sizes, corners, vertices = result["face_sizes"], result["faces"], result["vertices"]
+    assert vertices.ndim == 2 and vertices.shape[1] == 3
+    assert sizes.sum() == len(corners)
+    assert corners.min() >= 0 and corners.max() < len(vertices)
+    assert np.all(sizes >= 3)
+
+
+def test_simplify_reaches_the_target_and_keeps_quads():
+    vertices, quads, _, _ = torus()
+    r = quadlod.simplify(vertices, quads, ratio=0.5)
+    check_layout(r)
+    rep = r["report"]
+    assert rep["input_tri_equivalent"] == 2 * len(quads)
+    assert rep["target"] == len(quads)  # half of 2 per quad
+    assert rep["achieved"] == tri_equivalents(r["face_sizes"])
+    assert abs(rep["achieved"] - rep["target"]) <= 0.03 * rep["target"]  # Eq. 2's band, ε_n = 3 %
+    # The torus halves mostly by collapsing whole poly-chords: it stays quad-dominant (measured:
+    # 142 of 146 faces are quads).
+    assert np.mean(r["face_sizes"] == 4) >= 0.9
+    assert rep["quads"] == np.sum(r["face_sizes"] == 4)
+    assert rep["triangles"] == np.sum(r["face_sizes"] == 3)
+
+
+def test_face_forms_and_dtypes_give_the_same_mesh():
+    vertices, quads, _, _ = torus()
+    a = quadlod.simplify(vertices, quads, ratio=0.5)
+    # Blender's dtypes (float32 coordinates, int32 loops) read as the same numbers in float64.
+    flat = (quads.ravel().astype(np.int32), np.full(len(quads), 4, dtype=np.int32))
+    b = quadlod.simplify(vertices.astype(np.float32), flat, ratio=0.5)
+    b_ref = quadlod.simplify(vertices.astype(np.float32).astype(np.float64), quads, ratio=0.5)
+    # Plain lists are converted by NumPy.
+    c = quadlod.simplify(vertices.tolist(), (list(quads.ravel()), [4] * len(quads)), ratio=0.5)
+    for got, want in ((b, b_ref), (c, a)):
+        np.testing.assert_array_equal(got["faces"], want["faces"])
+        np.testing.assert_array_equal(got["face_sizes"], want["face_sizes"])
+        np.testing.assert_array_equal(got["vertices"], want["vertices"])
+    # Strided (non-contiguous) views are read in place.
+    wide = np.zeros((len(vertices), 6))
+    wide[:, ::2] = vertices
+    d = quadlod.simplify(wide[:, ::2], quads, ratio=0.5)
+    np.testing.assert_array_equal(a["vertices"], d["vertices"])
+
+
+def test_faces_target_counts_triangle_equivalents():
+    vertices, quads, _, _ = torus()
+    r = quadlod.simplify(vertices, quads, faces_target=300)
+    assert r["report"]["target"] == 300
+    assert abs(r["report"]["achieved"] - 300) <= 0.03 * 300
+
+
+def test_uvs_and_materials_come_back_per_corner_and_per_face():
+    vertices, quads, uvs, materials = torus()
+    r = quadlod.simplify(vertices, quads, ratio=0.5, uvs={"UVMap": uvs, "Second": uvs * 2}, materials=materials)
+    check_layout(r)
+    assert set(r["uvs"]) == {"UVMap", "Second"}
+    for layer in r["uvs"].values():
+        assert layer.shape == (len(r["faces"]), 2)
+        assert np.all(np.isfinite(layer))
+    np.testing.assert_allclose(r["uvs"]["Second"], 2 * r["uvs"]["UVMap"], rtol=0, atol=1e-12)
+    assert r["materials"].shape == r["face_sizes"].shape
+    assert set(np.unique(r["materials"])) == {0, 1}
+    single = quadlod.simplify(vertices, quads, ratio=0.5, uvs=uvs)
+    assert isinstance(single["uvs"], np.ndarray) and single["uvs"].shape == (len(single["faces"]), 2)
+
+
+def test_lod_chain_reduces_each_level_from_the_previous():
+    vertices, quads, uvs, materials = torus()
+    chain = quadlod.lod_chain(vertices, quads, levels=3, ratio=0.5, uvs=uvs, materials=materials)
+    assert len(chain) == 3
+    full = 2 * len(quads)
+    for k, level in enumerate(chain, start=1):
+        check_layout(level)
+        assert level["report"]["target"] == round(full * 0.5 ** k)
+        assert abs(level["report"]["achieved"] - level["report"]["target"]) <= 0.03 * level["report"]["target"] + 2
+    # Level 2 is the reduction of level 1's output: the same as simplify() on it.
+    first = chain[0]
+    again = quadlod.simplify(first["vertices"], (first["faces"], first["face_sizes"]),
+                             faces_target=chain[1]["report"]["target"], uvs=first["uvs"], materials=first["materials"])
+    np.testing.assert_array_equal(again["faces"], chain[1]["faces"])
+    np.testing.assert_array_equal(again["vertices"], chain[1]["vertices"])
+    explicit = quadlod.lod_chain(vertices, quads, ratios=[0.5, 0.25, 0.125], uvs=uvs, materials=materials)
+    np.testing.assert_array_equal(explicit[2]["faces"], chain[2]["faces"])
+
+
+def test_evaluate_matches_the_definitions_on_known_answers():
+    vertices, quads, _, _ = torus()
+    same = quadlod.evaluate((vertices, quads), (vertices, quads), samples=5000)
+    assert same["chamfer"] == pytest.approx(0.0, abs=1e-12)
+    assert same["hausdorff"] == pytest.approx(0.0, abs=1e-12)
+    assert same["quads_in"] == same["quads_out"] == len(quads)
+    r = quadlod.simplify(vertices, quads, ratio=0.5)
+    metrics = quadlod.evaluate((vertices, quads), r, samples=5000)
+    assert metrics["tri_equivalent_out"] == r["report"]["achieved"]
+    assert metrics["quads_out"] == r["report"]["quads"]
+    assert 0 < metrics["chamfer"] < metrics["hausdorff"] < 0.2
+    assert metrics["validity"]["nonmanifold_edges"] == 0
+
+
+def test_errors_are_exceptions_with_the_library_message():
+    vertices, quads, _, _ = torus()
+    bad = vertices.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(quadlod.QuadlodError, match=r"^vertex 3 \(1-based\) has a non-finite coordinate$"):
+        quadlod.simplify(bad, quads, ratio=0.5)
+    out_of_range = quads.copy()
+    out_of_range[5, 2] = len(vertices)
+    with pytest.raises(quadlod.QuadlodError, match="out of range"):
+        quadlod.simplify(vertices, out_of_range, ratio=0.5)
+    with pytest.raises(quadlod.QuadlodError, match="face_sizes add up to"):
+        quadlod.simplify(vertices, (quads.ravel(), [4] * (len(quads) - 1)), ratio=0.5)
+    with pytest.raises(quadlod.QuadlodError, match="uvs: 3 rows"):
+        quadlod.simplify(vertices, quads, ratio=0.5, uvs=np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="give a target"):
+        quadlod.simplify(vertices, quads)
+    with pytest.raises(ValueError, match="ratio"):
+        quadlod.simplify(vertices, quads, ratio=1.5)
+    with pytest.raises(TypeError, match="faces_target: an integer"):
+        quadlod.simplify(vertices, quads, faces_target="many")
+    with pytest.raises(TypeError, match="option 'seed': wrong type"):
+        quadlod.simplify(vertices, quads, ratio=0.5, seed="x")
+    with pytest.raises(TypeError, match="unknown option 'no_such_option'"):
+        quadlod.simplify(vertices, quads, ratio=0.5, no_such_option=1)
+    assert issubclass(quadlod.QuadlodError, ValueError)
+
+
+def test_the_input_arrays_are_not_modified():
+    vertices, quads, uvs, materials = torus()
+    copies = [a.copy() for a in (vertices, quads, uvs, materials)]
+    quadlod.simplify(vertices, quads, ratio=0.3, uvs=uvs, materials=materials)
+    for before, after in zip(copies, (vertices, quads, uvs, materials)):
+        np.testing.assert_array_equal(before, after)
+
+
+@pytest.mark.skipif(not CLI, reason="QUADLOD_CLI not set (CTest sets it)")
+def test_same_output_as_the_cli(tmp_path):
+    """The module and `quadlod simplify` give the same mesh for the same file and options."""
+    source, reduced = tmp_path / "vase.obj", tmp_path / "vase_40.obj"
+    subprocess.run([CLI, "generate", "vase", "-o", str(source)], check=True, capture_output=True)
+    subprocess.run([CLI, "-q", "simplify", str(source), "-o", str(reduced), "--ratio", "0.4"],
+                   check=True, capture_output=True)
+    m = quadlod.read_mesh(str(source))
+    r = quadlod.simplify(m["vertices"], (m["faces"], m["face_sizes"]), ratio=0.4, uvs=m.get("uvs"),
+                         normals=m.get("normals"), materials=m.get("materials"))
+    expected = quadlod.read_mesh(str(reduced))
+    np.testing.assert_array_equal(r["face_sizes"], expected["face_sizes"])
+    np.testing.assert_array_equal(r["faces"], expected["faces"])
+    np.testing.assert_allclose(r["vertices"], expected["vertices"], rtol=0, atol=1e-8)  # OBJ's 9 digits
+    # And the write → read round trip of the module's own writer.
+    written = tmp_path / "module.obj"
+    quadlod.write_mesh(r, str(written))
+    np.testing.assert_array_equal(quadlod.read_mesh(str(written))["faces"], expected["faces"])
+
+
+@pytest.mark.skipif(not CLI, reason="QUADLOD_CLI not set (CTest sets it)")
+def test_read_errors_carry_the_cli_message(tmp_path):
+    broken = tmp_path / "broken.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
+    cli = subprocess.run([CLI, "info", str(broken)], capture_output=True, text=True)
+    assert cli.returncode == 2
+    with pytest.raises(quadlod.QuadlodError) as error:
+        quadlod.read_mesh(str(broken))
+    assert cli.stderr.strip() == "quadlod: " + str(error.value)
+
+
+CORPUS = os.environ.get("QUADLOD_CORPUS_DIR", "")
+
+
+@pytest.mark.skipif(not CLI, reason="QUADLOD_CLI not set (CTest sets it)")
+@pytest.mark.parametrize("name", ["collada_duck", "flightgear_head_amelia"])
+def test_same_output_as_the_cli_on_corpus_meshes_with_uvs(tmp_path, name):
+    """Corpus meshes with UVs (and the duck's normals): OBJ's shared UV / normal pools become one
+    entry per corner in the module, and the output is still the CLI's, UVs included."""
+    source = os.path.join(CORPUS, name + ".obj")
+    if not os.path.exists(source):
+        pytest.skip(f"{source} not present (../shared/corpus)")
+    reduced = tmp_path / "out.obj"
+    subprocess.run([CLI, "-q", "simplify", source, "-o", str(reduced), "--ratio", "0.5"], check=True, capture_output=True)
+    m = quadlod.read_mesh(source)
+    r = quadlod.simplify(m["vertices"], (m["faces"], m["face_sizes"]), ratio=0.5, uvs=m.get("uvs"),
+                         normals=m.get("normals"))
+    expected = quadlod.read_mesh(str(reduced))
+    np.testing.assert_array_equal(r["faces"], expected["faces"])
+    np.testing.assert_array_equal(r["face_sizes"], expected["face_sizes"])
+    np.testing.assert_allclose(r["vertices"], expected["vertices"], rtol=0, atol=1e-6)
+    (got,), (want,) = r["uvs"].values(), expected["uvs"].values()
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-6)
