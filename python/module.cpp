@@ -41,7 +41,9 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"triangle_penalty", set_field(&SimplifyOptions::triangle_penalty)},
       {"swap_rounds", set_field(&SimplifyOptions::swap_rounds)},
       {"shape_flip_angle", set_field(&SimplifyOptions::shape_flip_angle_deg)},
+      {"effort", set_field(&SimplifyOptions::effort)},
       {"time_limit", set_field(&SimplifyOptions::time_limit_seconds)},
+      {"time_bound", set_field(&SimplifyOptions::time_bound_seconds)},
       {"threads", set_field(&SimplifyOptions::threads)},
       {"seed", set_field(&SimplifyOptions::seed)},
       {"formulation", [](SimplifyOptions& o, const py::handle& v) {
@@ -251,7 +253,7 @@ corner count of each face, as Blender and trimesh hold polygons — or an (F, k)
 ratio: target as a fraction of the input's triangle-equivalents (quad = 2, k-gon = k - 2), or
 faces_target: that count. uvs: per-corner (C, 2) or {name: (C, 2)}; normals: per-corner (C, 3);
 materials: per-face slot index (F,). Further keywords are the CLI's options with '_' for '-'
-(objective, time_limit, threads, seed, features, hard_angle, max_hausdorff, pass_ratio, ...).
+(objective, effort, time_limit, time_bound, threads, seed, features, hard_angle, max_hausdorff, pass_ratio, ...).
 Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials] of the reduced mesh and
 report (the JSON report of `simplify --report`, plus target/achieved/quads/triangles/ngons).
 Raises QuadlodError with the CLI's message on bad input.)");

@@ -62,6 +62,19 @@ def test_simplify_reaches_the_target_and_keeps_quads():
     assert rep["triangles"] == np.sum(r["face_sizes"] == 3)
 
 
+def test_effort_plans_passes_and_is_deterministic():
+    vertices, quads, _, _ = torus()
+    base = quadlod.simplify(vertices, quads, ratio=0.4)
+    more = quadlod.simplify(vertices, quads, ratio=0.4, effort=2.0)
+    assert base["report"]["passes_planned"] == 9  # ceil(log 0.4 / log 0.9)
+    assert more["report"]["passes_planned"] == 18  # twice the passes
+    again = quadlod.simplify(vertices, quads, ratio=0.4, effort=2.0)
+    assert np.array_equal(more["vertices"], again["vertices"])
+    assert np.array_equal(more["faces"], again["faces"])
+    with pytest.raises(quadlod.QuadlodError):
+        quadlod.simplify(vertices, quads, ratio=0.4, effort=0.0)
+
+
 def test_face_forms_and_dtypes_give_the_same_mesh():
     vertices, quads, _, _ = torus()
     a = quadlod.simplify(vertices, quads, ratio=0.5)

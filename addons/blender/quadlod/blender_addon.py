@@ -21,8 +21,9 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 from . import _core  # the package loaded it (see _load_core in __init__.py)
 
 EFFORT_ITEMS = [
-    ("FAST", "Fast", "Shape objective, greedy only (no exchange rounds, one selection round)"),
+    ("FAST", "Fast", "Shape objective at effort 0.5: half the passes (deterministic)"),
     ("DEFAULT", "Default", "Shape objective with the CLI's defaults (deterministic)"),
+    ("THOROUGH", "Thorough", "Shape objective at effort 2: twice the passes, slower, usually closer to the input (deterministic)"),
     ("ILP", "ILP (time limit)", "The paper's objective with the MIP search, bounded by the time limit"),
 ]
 
@@ -207,7 +208,9 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
     def _options(self):
         options = dict(features=self.protect_uv_seams)
         if self.effort == "FAST":
-            options.update(swap_rounds=0, max_rounds=1)
+            options.update(effort=0.5)
+        elif self.effort == "THOROUGH":
+            options.update(effort=2.0)
         elif self.effort == "ILP":
             options.update(objective="paper", time_limit=self.time_limit)
         return options
