@@ -116,6 +116,10 @@ class SceneBuilder {
     std::vector<unsigned> group;
     for (unsigned i = 0; i < node.mNumMeshes; ++i)
       if (node.mMeshes[i] < ai_.mNumMeshes) group.push_back(node.mMeshes[i]);
+    const std::vector<const aiNode*> folded = per_material_children(node);
+    for (const aiNode* child : folded)
+      for (unsigned i = 0; i < child->mNumMeshes; ++i)
+        if (child->mMeshes[i] < ai_.mNumMeshes) group.push_back(child->mMeshes[i]);
     std::sort(group.begin(), group.end());
     group.erase(std::unique(group.begin(), group.end()), group.end());
     scene_.nodes.push_back(std::move(out));
@@ -123,15 +127,40 @@ class SceneBuilder {
       const Index mesh = mesh_of_group(group, node);
       if (mesh != kInvalidIndex) scene_.nodes[id].meshes.push_back(mesh);
     }
-    for (unsigned i = 0; i < node.mNumChildren; ++i) add_node(*node.mChildren[i], id);
+    for (unsigned i = 0; i < node.mNumChildren; ++i)
+      if (std::find(folded.begin(), folded.end(), node.mChildren[i]) == folded.end()) add_node(*node.mChildren[i], id);
+  }
+
+  /// assimp's FBX exporter (and so our .fbx files) moves the meshes of a node with several
+  /// materials into one child node per material, all named after the mesh, identity transform,
+  /// no children of their own:  grid_a → {grid (red), grid (blue)}. Read back as they are, the
+  /// mesh would come apart at its material borders. Such children (two or more, one shared
+  /// name, under a node without meshes) are folded back into their parent's mesh.
+  std::vector<const aiNode*> per_material_children(const aiNode& node) const {
+    std::vector<const aiNode*> children;
+    if (node.mNumMeshes > 0) return children;
+    for (unsigned i = 0; i < node.mNumChildren; ++i) {
+      const aiNode* c = node.mChildren[i];
+      if (c->mNumChildren > 0 || c->mNumMeshes == 0 || !c->mTransformation.IsIdentity()) continue;
+      bool named_after_mesh = true;
+      for (unsigned k = 0; k < c->mNumMeshes; ++k)
+        named_after_mesh = named_after_mesh && c->mMeshes[k] < ai_.mNumMeshes &&
+                           ai_.mMeshes[c->mMeshes[k]]->mName == c->mName;
+      if (named_after_mesh && (children.empty() || children[0]->mName == c->mName)) children.push_back(c);
+    }
+    if (children.size() < 2) children.clear();
+    return children;
   }
 
   /// The Scene mesh of a node's set of aiMeshes; the same set in another node is an instance.
   Index mesh_of_group(const std::vector<unsigned>& group, const aiNode& node) {
     if (auto it = mesh_of_group_.find(group); it != mesh_of_group_.end()) return it->second;
     SceneMesh out;
-    out.name = group.size() == 1 && ai_.mMeshes[group[0]]->mName.length > 0 ? ai_.mMeshes[group[0]]->mName.C_Str()
-                                                                             : node.mName.C_Str();
+    // The aiMeshes' name when they share one (a mesh split by material), else the node's.
+    out.name = ai_.mMeshes[group[0]]->mName.C_Str();
+    for (unsigned m : group)
+      if (ai_.mMeshes[m]->mName != ai_.mMeshes[group[0]]->mName) out.name.clear();
+    if (out.name.empty()) out.name = node.mName.C_Str();
     weld(group, out.mesh);
     Index id = kInvalidIndex;
     if (out.mesh.num_faces() > 0) {
