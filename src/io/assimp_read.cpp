@@ -27,6 +27,7 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <unordered_map>
@@ -94,7 +95,8 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
 
 class SceneBuilder {
  public:
-  explicit SceneBuilder(const aiScene& ai) : ai_(ai) {}
+  SceneBuilder(const aiScene& ai, const SceneReadOptions& options)
+      : ai_(ai), normal_weld_cos_(std::cos(options.normal_weld_degrees * 3.14159265358979323846 / 180.0)) {}
 
   Scene build() {
     for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.materials.push_back(read_material(*ai_.mMaterials[i], i));
@@ -187,6 +189,7 @@ class SceneBuilder {
     for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
     Pool<Vec3> normal_pool{&mesh.normals, {}};
     std::unordered_map<FloatKey, Index, FloatKeyHash> vertex_of;
+    std::vector<std::vector<Index>> normals_at;  // per welded vertex: the normal entries its corners use
     std::map<std::string, Index> material_of;
     std::vector<Index> face;
 
@@ -209,6 +212,7 @@ class SceneBuilder {
         auto [it, inserted] = vertex_of.try_emplace(key_of(p.x, p.y, p.z), mesh.num_vertices());
         if (inserted) {
           mesh.positions.emplace_back(p.x, p.y, p.z);
+          normals_at.emplace_back();
           if (colours) {
             const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
             mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
@@ -250,6 +254,7 @@ class SceneBuilder {
             if (a.HasNormals()) {
               const aiVector3D& t = a.mNormals[v];
               n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
+              n = weld_normal(mesh.normals, normals_at[welded[v]], n);
             }
             mesh.corner_normal.push_back(n);
           }
@@ -260,6 +265,18 @@ class SceneBuilder {
     }
   }
 
+  /// The normal entry a corner of a vertex uses: an entry another corner of that vertex already
+  /// uses when it lies within the weld angle (SceneReadOptions::normal_weld_degrees), else `n`.
+  Index weld_normal(const std::vector<Vec3>& pool, std::vector<Index>& at_vertex, Index n) const {
+    for (Index used : at_vertex) {
+      if (used == n) return n;
+      const double lengths = pool[used].norm() * pool[n].norm();
+      if (lengths > 0 && pool[used].dot(pool[n]) >= normal_weld_cos_ * lengths) return used;
+    }
+    at_vertex.push_back(n);
+    return n;
+  }
+
   /// Issue 24: bones and weights of aiMesh `a` go into `out` here (its vertices are welded by
   /// position: a bone's vertex v maps to the welded vertex of a.mVertices[v]).
   void per_mesh_extras(const aiMesh& a, SceneMesh& out) {}
@@ -267,6 +284,7 @@ class SceneBuilder {
   void scene_extras() {}
 
   const aiScene& ai_;
+  const double normal_weld_cos_;
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
 };
@@ -281,7 +299,8 @@ void configure(Assimp::Importer& importer) {
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
 }
 
-SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name) {
+SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
+                       const SceneReadOptions& options) {
   SceneReadResult result;
   if (!ai) {
     std::string message = importer.GetErrorString();
@@ -289,7 +308,7 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
     result.error = name + ": assimp: " + message;
     return result;
   }
-  result.scene = SceneBuilder(*ai).build();
+  result.scene = SceneBuilder(*ai, options).build();
   return result;
 }
 
@@ -300,7 +319,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 namespace io_detail {
-SceneReadResult read_scene_with_assimp(const std::filesystem::path& path) {
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const SceneReadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -312,14 +331,14 @@ SceneReadResult read_scene_with_assimp(const std::filesystem::path& path) {
   Assimp::Importer importer;
   configure(importer);
   const aiScene* ai = importer.ReadFile(path.string(), kImportSteps);
-  SceneReadResult result = finish(ai, importer, path.string());
+  SceneReadResult result = finish(ai, importer, path.string(), options);
   result.seconds = seconds_since(start);
   return result;
 }
 }  // namespace io_detail
 
 SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::string_view hint,
-                                       const std::string& name) {
+                                       const std::string& name, const SceneReadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Assimp::Importer importer;
   configure(importer);
@@ -329,7 +348,7 @@ SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::
   if (size == 0)
     result.error = name + ": empty buffer";
   else
-    result = finish(ai, importer, name);
+    result = finish(ai, importer, name, options);
   result.seconds = seconds_since(start);
   return result;
 }
