@@ -12,6 +12,7 @@ import argparse
 import json
 import os
 import re
+import struct
 import subprocess
 import sys
 import time
@@ -76,6 +77,16 @@ def blender_counts(paths):
     return counts
 
 
+def write_float32_obj(src, dst):
+    with open(src) as f, open(dst, "w") as out:
+        for line in f:
+            if line.startswith(("v ", "vt ", "vn ")):
+                p = line.split()
+                out.write(p[0] + " " + " ".join(repr(struct.unpack("f", struct.pack("f", float(x)))[0]) for x in p[1:]) + "\n")
+            else:
+                out.write(line)
+
+
 def quad_fraction(q, t, n):
     return q / (q + t + n) if q + t + n else 0.0
 
@@ -109,7 +120,7 @@ def main():
                 faces = sum(1 for line in f if line.startswith("f "))
             if faces < a.max_faces:
                 meshes.append(os.path.join(a.corpus, name))
-    worst = {"simplify": 0.0, "lod": 0.0}
+    worst = {"simplify": 0.0, "lod": 0.0, "simplify32": 0.0, "lod32": 0.0}
     print(f"{'mesh':34} {'fmt':4} {'in quads/tris/ngons':>20} {'simplify out (quadlod)':>24} "
           f"{'out (blender)':>18} {'qf':>6} {'dqf':>7} {'lod qf per level':>22} {'dqf':>7} {'s':>6}")
     for mesh in meshes:
@@ -121,13 +132,19 @@ def main():
             with open(mesh) as f:
                 has_normals = any(line.startswith("vn ") for line in f)
             blender(CONVERT, mesh, fbx, glb, "keep" if has_normals else "smooth")
+        # The OBJ with every coordinate rounded to float32, as Blender and FBX store them: the
+        # reduction's own sensitivity to that rounding is the floor of any FBX-vs-OBJ difference.
+        obj32 = os.path.join(d, stem + ".f32.obj")
+        if not os.path.exists(obj32):
+            write_float32_obj(mesh, obj32)
         results = {}
-        for fmt, src in (("obj", mesh), ("fbx", fbx), ("glb", glb)):
-            out_file = os.path.join(d, "out." + fmt)
+        for fmt, src in (("obj", mesh), ("obj32", obj32), ("fbx", fbx), ("glb", glb)):
+            ext = "obj" if fmt == "obj32" else fmt
+            out_file = os.path.join(d, "out_" + fmt + "." + ext)
             stdout, sec = run([a.quadlod, "-q", "simplify", src, "-o", out_file, "--ratio", a.ratio])
             q, t, n = map(int, FACES_RE.search(stdout).groups())
             lod_dir = os.path.join(d, "lod_" + fmt)
-            _, lsec = run([a.quadlod, "-q", "lod", src, "-o", lod_dir, "--levels", a.levels, "--format", fmt])
+            _, lsec = run([a.quadlod, "-q", "lod", src, "-o", lod_dir, "--levels", a.levels, "--format", ext])
             with open(os.path.join(lod_dir, "lods.json")) as f:
                 levels = json.load(f)["levels"]
             results[fmt] = {"counts": (q, t, n), "seconds": sec + lsec, "out": out_file,
@@ -137,13 +154,16 @@ def main():
         blender_paths = [results["fbx"]["out"], *results["fbx"]["lod_files"]]
         counts = blender_counts(blender_paths)
         ref = quad_fraction(*results["obj"]["counts"])
-        for fmt in ("obj", "fbx", "glb"):
+        for fmt in ("obj", "obj32", "fbx", "glb"):
             r = results[fmt]
             qf = quad_fraction(*r["counts"])
             bl = counts.get(r["out"], None)
             bl_text = "/".join(map(str, bl)) if bl else "-"
             dqf = qf - ref
             lod_d = max(abs(x - y) for x, y in zip(r["lod_qf"], results["obj"]["lod_qf"]))
+            if fmt == "obj32":
+                worst["simplify32"] = max(worst["simplify32"], abs(dqf))
+                worst["lod32"] = max(worst["lod32"], lod_d)
             if fmt == "fbx":
                 worst["simplify"] = max(worst["simplify"], abs(dqf))
                 worst["lod"] = max(worst["lod"], lod_d)
@@ -157,7 +177,8 @@ def main():
                   f"{qf:6.3f} {dqf:+7.3f} {','.join(f'{x:.3f}' for x in r['lod_qf']):>22} {lod_d:7.3f} "
                   f"{r['seconds']:6.1f}", flush=True)
     print(f"largest |quad fraction (fbx) - quad fraction (obj)|: simplify {worst['simplify']:.4f}, "
-          f"lod {worst['lod']:.4f} (bar: 0.01)")
+          f"lod {worst['lod']:.4f} (bar: 0.01); the OBJ rounded to float32 against the OBJ: "
+          f"simplify {worst['simplify32']:.4f}, lod {worst['lod32']:.4f}")
 
 
 if __name__ == "__main__":

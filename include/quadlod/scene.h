@@ -101,7 +101,8 @@ bool scene_readable_path(const std::filesystem::path& path);
 ///   * runs no triangulation and no vertex joining of its own: the meshes of one node (assimp
 ///     splits a mesh by material) become one PolyMesh, whose vertices are the distinct corner
 ///     positions (exact float equality) — the topology the exporter split at UV / normal / material
-///     seams comes back — and whose UV sets (all of them, named when the file names them),
+///     seams comes back; a face whose vertices would all be those of an earlier face (surfaces
+///     lying on top of each other) gets vertices of its own instead — and whose UV sets (all of them, named when the file names them),
 ///     normals and first colour set are pools with one index per corner (deduplicated by value;
 ///     the normals of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
 ///   * drops points, lines and faces with fewer than 3 distinct corners (counted in

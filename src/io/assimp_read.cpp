@@ -31,6 +31,7 @@
 #include <cstring>
 #include <map>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace quadlod {
 
@@ -53,6 +54,14 @@ FloatKey key_of(float x, float y, float z) {
   const auto b = [](float v) { return std::bit_cast<std::uint32_t>(v == 0.0f ? 0.0f : v); };
   return {{b(x), b(y), b(z)}};
 }
+
+struct IndexListHash {
+  std::size_t operator()(const std::vector<Index>& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (Index v : k) h = (h ^ v) * 1099511628211ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
 
 /// A pool of values deduplicated by bit pattern.
 template <class Value>
@@ -188,10 +197,14 @@ class SceneBuilder {
     std::vector<Pool<Vec2>> uv_pools(uv_sets);
     for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
     Pool<Vec3> normal_pool{&mesh.normals, {}};
-    std::unordered_map<FloatKey, Index, FloatKeyHash> vertex_of;
+    // Distinct positions, and per position the welded vertices standing on it ("layers"; more
+    // than one only where surfaces lie on top of each other, see place_face).
+    std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
+    std::vector<std::vector<Index>> layers;
+    std::unordered_set<std::vector<Index>, IndexListHash> faces_seen;
     std::vector<std::vector<Index>> normals_at;  // per welded vertex: the normal entries its corners use
     std::map<std::string, Index> material_of;
-    std::vector<Index> face;
+    std::vector<Index> face, chosen, key;
 
     for (unsigned m : group) {
       const aiMesh& a = *ai_.mMeshes[m];
@@ -205,42 +218,71 @@ class SceneBuilder {
         if (inserted) mesh.material_names.push_back(name);
         material = it->second;
       }
-      // Welded vertex id of each aiMesh vertex.
-      std::vector<Index> welded(a.mNumVertices);
+      // Position id of each aiMesh vertex.
+      std::vector<Index> position(a.mNumVertices);
       for (unsigned v = 0; v < a.mNumVertices; ++v) {
         const aiVector3D& p = a.mVertices[v];
-        auto [it, inserted] = vertex_of.try_emplace(key_of(p.x, p.y, p.z), mesh.num_vertices());
-        if (inserted) {
-          mesh.positions.emplace_back(p.x, p.y, p.z);
+        auto [it, inserted] = position_of.try_emplace(key_of(p.x, p.y, p.z), static_cast<Index>(layers.size()));
+        if (inserted) layers.emplace_back();
+        position[v] = it->second;
+      }
+      for (unsigned f = 0; f < a.mNumFaces; ++f) {
+        const aiFace& af = a.mFaces[f];
+        // Corners (aiMesh vertex ids) with consecutive repeats removed; a face that still uses
+        // a position twice, or has fewer than 3 corners, is dropped (counted).
+        face.clear();
+        for (unsigned c = 0; c < af.mNumIndices; ++c) {
+          const unsigned v = af.mIndices[c];
+          if (v >= a.mNumVertices) { face.clear(); break; }
+          if (!face.empty() && position[face.back()] == position[v]) continue;
+          face.push_back(v);
+        }
+        while (face.size() > 1 && position[face.front()] == position[face.back()]) face.pop_back();
+        bool repeated = face.size() < 3;
+        for (std::size_t i = 0; i < face.size() && !repeated; ++i)
+          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = position[face[i]] == position[face[j]];
+        if (repeated) {
+          ++scene_.dropped_primitives;
+          continue;
+        }
+        // Welding by position alone would make two faces lying exactly on top of each other (hair
+        // cards, doubled shells: separate vertices in the source) one face used twice. A face
+        // whose welded vertices are those of an earlier face goes one layer up instead, onto
+        // vertices of its own, and the faces after it that repeat faces of the lower layer
+        // follow it there — so a doubled surface comes back as two connected surfaces.
+        std::size_t layer = 0;
+        for (;; ++layer) {
+          key.clear();
+          for (unsigned v : face) {
+            if (layers[position[v]].size() <= layer) break;
+            key.push_back(layers[position[v]][layer]);
+          }
+          if (key.size() < face.size()) break;
+          std::sort(key.begin(), key.end());
+          if (!faces_seen.count(key)) break;
+        }
+        chosen.clear();
+        for (unsigned v : face) {
+          std::vector<Index>& here = layers[position[v]];
+          if (here.size() > layer) {
+            chosen.push_back(here[layer]);
+            continue;
+          }
+          const aiVector3D& p = a.mVertices[v];
+          here.push_back(mesh.add_vertex(Vec3(p.x, p.y, p.z)));
           normals_at.emplace_back();
           if (colours) {
             const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
             mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
           }
+          chosen.push_back(here.back());
         }
-        welded[v] = it->second;
-      }
-      for (unsigned f = 0; f < a.mNumFaces; ++f) {
-        const aiFace& af = a.mFaces[f];
-        // Corners (aiMesh vertex ids) with consecutive repeats removed; a face that still uses
-        // a vertex twice, or has fewer than 3 corners, is dropped (counted).
-        face.clear();
-        for (unsigned c = 0; c < af.mNumIndices; ++c) {
-          const unsigned v = af.mIndices[c];
-          if (v >= a.mNumVertices) { face.clear(); break; }
-          if (!face.empty() && welded[face.back()] == welded[v]) continue;
-          face.push_back(v);
-        }
-        while (face.size() > 1 && welded[face.front()] == welded[face.back()]) face.pop_back();
-        bool repeated = face.size() < 3;
-        for (std::size_t i = 0; i < face.size() && !repeated; ++i)
-          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = welded[face[i]] == welded[face[j]];
-        if (repeated) {
-          ++scene_.dropped_primitives;
-          continue;
-        }
-        for (unsigned v : face) {
-          mesh.corner_vertex.push_back(welded[v]);
+        key = chosen;
+        std::sort(key.begin(), key.end());
+        faces_seen.insert(key);
+        for (std::size_t i = 0; i < face.size(); ++i) {
+          const unsigned v = face[i];
+          mesh.corner_vertex.push_back(chosen[i]);
           for (unsigned k = 0; k < uv_sets; ++k) {
             Index uv = kInvalidIndex;
             if (a.HasTextureCoords(k)) {
@@ -254,7 +296,7 @@ class SceneBuilder {
             if (a.HasNormals()) {
               const aiVector3D& t = a.mNormals[v];
               n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
-              n = weld_normal(mesh.normals, normals_at[welded[v]], n);
+              n = weld_normal(mesh.normals, normals_at[chosen[i]], n);
             }
             mesh.corner_normal.push_back(n);
           }
@@ -277,8 +319,9 @@ class SceneBuilder {
     return n;
   }
 
-  /// Issue 24: bones and weights of aiMesh `a` go into `out` here (its vertices are welded by
-  /// position: a bone's vertex v maps to the welded vertex of a.mVertices[v]).
+  /// Issue 24: bones and weights of aiMesh `a` go into `out` here. An aiMesh vertex v lands on
+  /// the welded vertex of its position (on the layer of the faces using it, see weld()): record
+  /// that map in weld() next to `chosen` when the weights need it.
   void per_mesh_extras(const aiMesh& a, SceneMesh& out) {}
   /// Issue 24: skeleton (nodes already read) and ai_.mAnimations go here.
   void scene_extras() {}
