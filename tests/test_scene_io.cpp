@@ -360,3 +360,32 @@ TEST(SceneWeld, NormalsWithinTheWeldAngleShareAnEntry) {
   const auto [e, f] = shared_vertex_normals(0.01, exact);
   EXPECT_NE(e, f);
 }
+
+TEST(SceneWeld, SurfacesOnTopOfEachOtherStayApart) {
+  // Two copies of a 3×2 grid at the same place (a doubled hair card) in one mesh: welding by
+  // position alone would make every face of the second copy a repeat of the first's.
+  PolyMesh doubled = make_grid(3, 2);
+  const PolyMesh copy = make_grid(3, 2);
+  const Index base = doubled.num_vertices();
+  for (const Vec3& p : copy.positions) doubled.add_vertex(p);
+  for (Index f = 0; f < copy.num_faces(); ++f) {
+    std::vector<Index> face;
+    for (Index v : copy.face_vertices(f)) face.push_back(base + v);
+    doubled.add_face(face);
+  }
+  const fs::path dir = scratch_dir("scene-doubled");
+  ASSERT_TRUE(write_scene(scene_from_mesh(doubled, "doubled"), dir / "d.dae").ok());
+  const SceneReadResult r = read_scene(dir / "d.dae");
+  fs::remove_all(dir);
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  const PolyMesh& back = r.scene.meshes[0].mesh;
+  EXPECT_EQ(back.num_faces(), 12u);
+  EXPECT_EQ(back.num_vertices(), 24u);
+  std::set<std::vector<Index>> faces;
+  for (Index f = 0; f < back.num_faces(); ++f) {
+    std::vector<Index> key(back.face_vertices(f).begin(), back.face_vertices(f).end());
+    std::sort(key.begin(), key.end());
+    EXPECT_TRUE(faces.insert(key).second) << "face " << f << " repeats an earlier face";
+  }
+}
