@@ -74,7 +74,9 @@ TEST_P(SceneRoundTrip, KeepsCountsMaterialsUvsAndNodes) {
   for (const SceneMaterial& m : back.materials) materials.insert(m.name);
   EXPECT_TRUE(materials.count("red") && materials.count("blue")) << ext;
   for (const SceneMaterial& m : back.materials)
-    if (m.name == "red") EXPECT_NEAR(m.base_color[0], 0.8, 1e-5) << ext;
+    if (m.name == "red") {
+      EXPECT_NEAR(m.base_color[0], 0.8, 1e-5) << ext;
+    }
 
   // Both UV sets with their ranges.
   ASSERT_EQ(grid_a->mesh.uv_sets.size(), 2u) << ext;
