@@ -26,12 +26,13 @@ struct LodChainParams {
   std::vector<double> ratios{0.5, 0.25, 0.125};
   /// The reduction's options; `ratio` and `target_tri_equivalent` are set per level.
   SimplifyOptions simplify;
-  /// Measure each level's Hausdorff distance to the input (evaluate(), metrics.h) and derive
-  /// the switch threshold. false: hausdorff and screen_size are NaN.
+  /// Measure each level's Hausdorff distance to the input — evaluate()'s `hausdorff`
+  /// (metrics.h) for these samples and seed 1, without the rest of evaluate() — and derive the
+  /// switch threshold. false: hausdorff and screen_size are NaN.
   bool measure_hausdorff = true;
-  /// Surface samples per direction of that measurement (EvalParams::samples). 50000 keeps the
-  /// measurement well under the reduction's time on the corpus while the Hausdorff estimate
-  /// also includes every vertex of both meshes (EvalParams).
+  /// Surface samples per direction of that measurement (EvalParams::samples); every vertex of
+  /// both meshes is measured too. 50000 as a compromise of time and the estimate's resolution
+  /// (docs/lod.md has the measured cost).
   std::uint64_t hausdorff_samples = 50000;
   /// Screen-size rule (lod_screen_size): the level may be shown once its Hausdorff error
   /// projects to at most `pixel_tolerance` pixels on a screen `screen_height_pixels` tall.
