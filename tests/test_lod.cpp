@@ -160,3 +160,20 @@ TEST(SimplifyScene, TargetSplitByTriangleEquivalentsOrPerMesh) {
 
   EXPECT_FALSE(simplify_scene(Scene{}, params).ok());
 }
+
+TEST_F(LodCli, ObjLevelsElsewhereStillFindTheMtl) {
+  fs::create_directories(dir / "in");
+  PolyMesh grid = make_grid(8, 8);
+  grid.material_names = {"paint"};
+  grid.face_material.assign(grid.num_faces(), 0);
+  grid.material_libraries = {"g.mtl"};
+  ASSERT_TRUE(write_mesh(grid, dir / "in" / "g.obj").ok());
+  write_text(dir / "in" / "g.mtl", "newmtl paint\nKd 1 0 0\n");
+  const CliRun run = run_cli("-q lod '" + (dir / "in" / "g.obj").string() + "' -o '" + (dir / "out").string() +
+                                 "' --levels 0.5 --no-hausdorff", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const ReadResult level = read_mesh(dir / "out" / "g.lod1.obj");
+  ASSERT_TRUE(level.ok()) << level.error;
+  ASSERT_EQ(level.mesh.material_libraries.size(), 1u);
+  EXPECT_TRUE(fs::exists(dir / "out" / level.mesh.material_libraries[0])) << level.mesh.material_libraries[0];
+}

@@ -129,10 +129,12 @@ struct LodFilesResult {
   bool ok() const { return error.empty(); }
 };
 
-/// Writes every level of `chain` (write_scene, atomically) to lod_file_path(dir, stem, l,
+/// Writes every level of `chain` (write_scene, atomically) to lod_file_path(dir, input's stem, l,
 /// extension), then `dir/lods.json` (the report, with `extra` merged in) last — so a present
-/// lods.json means the whole chain is there. Creates `dir`.
-LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& dir, const std::string& stem,
-                               const std::string& extension, const nlohmann::json& extra);
+/// lods.json means the whole chain is there. Creates `dir`. OBJ levels keep finding the input's
+/// MTL files (rebase_material_libraries, io.h; its warnings are returned).
+LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& input,
+                               const std::filesystem::path& dir, const std::string& extension,
+                               const nlohmann::json& extra);
 
 }  // namespace quadlod
