@@ -2,15 +2,14 @@
 //
 // assimp hands over meshes whose vertices are split wherever a corner's attributes differ (and
 // FBX/glTF importers give every corner its own vertex), one aiMesh per material. quadlod's
-// reduction needs the surface's topology, so the meshes of one node are welded back together:
+// reduction needs the surface's topology, so the meshes of one node are glued back together:
 //
-//   aiMesh "body/mat A" ─┐   one PolyMesh: vertices = distinct corner positions,
-//   aiMesh "body/mat B" ─┼─► per-corner UV / normal pools (deduplicated by value),
-//                        │   face_material from each aiMesh's material
+//   aiMesh "body/mat A" ─┐   one PolyMesh: corners glued along edges with opposite half-edges
+//   aiMesh "body/mat B" ─┼─► on the same positions (glue_corners), per-corner UV / normal pools
+//                        │   (deduplicated by value), face_material from each aiMesh's material
 //
 // No post-process step triangulates or joins vertices (aiProcess_Triangulate /
-// JoinIdenticalVertices are not used): polygons stay polygons, and the welding here is exact
-// float equality of positions, which is what the exporter's split preserved.
+// JoinIdenticalVertices are not used): polygons stay polygons.
 //
 // Issue 24 (skins) adds bones / weights in `per_mesh_extras` and skeleton / animations in
 // `scene_extras`; nothing else here needs to change for it.
