@@ -24,6 +24,7 @@ struct SimplifyCliOptions {
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false;
+  bool per_mesh = false;
 };
 
 }  // namespace
@@ -31,8 +32,8 @@ struct SimplifyCliOptions {
 Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   auto opt = std::make_shared<SimplifyCliOptions>();
   CLI::App* sub = app.add_subcommand("simplify", "Reduce a quad-dominant mesh, keeping its edge loops");
-  sub->add_option("INPUT", opt->input, "Input mesh (.obj, .ply, .off)")->required();
-  sub->add_option("-o,--output", opt->output, "Output mesh (.obj, .ply, .off)")->required();
+  sub->add_option("INPUT", opt->input, "Input mesh (.obj, .ply, .off) or scene (.fbx, .glb, .gltf, .dae, .3ds, ...)")->required();
+  sub->add_option("-o,--output", opt->output, "Output mesh (.obj, .ply, .off) or scene (.glb, .fbx, .dae)")->required();
   auto* ratio = sub->add_option("--ratio", opt->ratio, "Target as a fraction of the input's triangle-equivalents")
                     ->check(CLI::Range(1e-6, 1.0))
                     ->group("Target (one of)");
@@ -41,6 +42,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                     ->group("Target (one of)");
   ratio->excludes(faces);
   faces->excludes(ratio);
+  sub->add_flag("--per-mesh", opt->per_mesh,
+                "Scenes: the target applies to each mesh (default: the scene's target, split by triangle-equivalents)")
+      ->group("Target (one of)");
   SimplifyOptions& p = opt->pipeline;
   sub->add_option("--objective", p.objective,
                   "shape (the geometric error of the output, deterministic greedy) or paper (Eq. 9 with the MIP search)")
@@ -144,13 +148,6 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             if (!opt->report_html.empty() &&
                 (same_file(opt->output, opt->report_html) || (!opt->report.empty() && same_file(opt->report, opt->report_html))))
               return fail(opt->report_html + ": the HTML report and another output are the same file");
-            MeshFormat format;
-            if (!format_from_path(opt->output, format))
-              return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
-            Stopwatch clock;
-            const ReadResult in = read_mesh(opt->input);
-            if (!in.ok()) return fail(in.error);
-            const double read_seconds = clock.seconds();
             SimplifyOptions p = opt->pipeline;
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
@@ -163,6 +160,17 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.greedy_fallback = !opt->no_greedy_fallback;
             p.features = !opt->no_features;
             p.progress = !global.quiet;
+            // Scenes (FBX, glTF, Collada, … on either side) go mesh by mesh (cmd_scene.cpp).
+            MeshFormat format, input_format;
+            if (!format_from_path(opt->output, format) || !format_from_path(opt->input, input_format)) {
+              if (!opt->report_html.empty())
+                return fail(opt->report_html + ": --report-html takes an OBJ, PLY or OFF input and output (use `quadlod report` on the meshes)");
+              return simplify_scene_file(opt->input, opt->output, opt->report, p, opt->per_mesh);
+            }
+            Stopwatch clock;
+            const ReadResult in = read_mesh(opt->input);
+            if (!in.ok()) return fail(in.error);
+            const double read_seconds = clock.seconds();
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);
             // The output may live elsewhere: keep its `mtllib` lines pointing at the input's MTL.

@@ -9,6 +9,10 @@
 #include <functional>
 #include <string>
 
+namespace quadlod {
+struct SimplifyOptions;
+}  // namespace quadlod
+
 namespace quadlod::cli {
 
 /// Exit codes, documented in README.md ("CLI reference").
@@ -37,6 +41,13 @@ Command add_analyze(CLI::App& app, const GlobalOptions& global);
 #ifdef QUADLOD_HTML_REPORT
 Command add_report(CLI::App& app, const GlobalOptions& global);
 #endif
+Command add_lod(CLI::App& app, const GlobalOptions& global);
+Command add_batch(CLI::App& app, const GlobalOptions& global);
+
+/// `quadlod simplify` on a scene (either side not OBJ / PLY / OFF): read_scene, simplify_scene,
+/// write_scene; prints one summary line (cmd_scene.cpp).
+int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
+                        const SimplifyOptions& options, bool per_mesh);
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

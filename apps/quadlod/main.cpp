@@ -38,6 +38,8 @@ int main(int argc, char** argv) {
 #ifdef QUADLOD_HTML_REPORT
       add_report(app, global),
 #endif
+      add_lod(app, global),
+      add_batch(app, global),
   };
 
   try {

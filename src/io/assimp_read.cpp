@@ -1,0 +1,472 @@
+// quadlod — the assimp front end of read_scene (include/quadlod/scene.h).
+//
+// assimp hands over meshes whose vertices are split wherever a corner's attributes differ (and
+// FBX/glTF importers give every corner its own vertex), one aiMesh per material. quadlod's
+// reduction needs the surface's topology, so the meshes of one node are glued back together:
+//
+//   aiMesh "body/mat A" ─┐   one PolyMesh: corners glued along edges with opposite half-edges
+//   aiMesh "body/mat B" ─┼─► on the same positions (glue_corners), per-corner UV / normal pools
+//                        │   (deduplicated by value), face_material from each aiMesh's material
+//
+// No post-process step triangulates or joins vertices (aiProcess_Triangulate /
+// JoinIdenticalVertices are not used): polygons stay polygons.
+//
+// Issue 24 (skins) adds bones / weights in `per_mesh_extras` and skeleton / animations in
+// `scene_extras`; nothing else here needs to change for it.
+#include "io/assimp_detail.h"
+#include "mesh/union_find.h"
+#include "quadlod/scene.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+namespace quadlod {
+
+namespace {
+
+/// Exact bit pattern of up to three floats: the welding and pooling key.
+struct FloatKey {
+  std::array<std::uint32_t, 3> bits{};
+  bool operator==(const FloatKey&) const = default;
+};
+struct FloatKeyHash {
+  std::size_t operator()(const FloatKey& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+FloatKey key_of(float x, float y, float z) {
+  // +0 and -0 weld together: both are the same point.
+  const auto b = [](float v) { return std::bit_cast<std::uint32_t>(v == 0.0f ? 0.0f : v); };
+  return {{b(x), b(y), b(z)}};
+}
+
+/// A pool of values deduplicated by bit pattern.
+template <class Value>
+struct Pool {
+  std::vector<Value>* values = nullptr;
+  std::unordered_map<FloatKey, Index, FloatKeyHash> index_of;
+  Index add(const FloatKey& key, const Value& value) {
+    auto [it, inserted] = index_of.try_emplace(key, static_cast<Index>(values->size()));
+    if (inserted) values->push_back(value);
+    return it->second;
+  }
+};
+
+std::string material_name(const aiMaterial& material, unsigned index) {
+  aiString name;
+  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS && name.length > 0) return name.C_Str();
+  return "material_" + std::to_string(index);
+}
+
+SceneMaterial read_material(const aiMaterial& material, unsigned index) {
+  SceneMaterial out;
+  out.name = material_name(material, index);
+  aiColor4D colour;
+  if (material.Get(AI_MATKEY_BASE_COLOR, colour) == AI_SUCCESS ||
+      material.Get(AI_MATKEY_COLOR_DIFFUSE, colour) == AI_SUCCESS)
+    out.base_color = {colour.r, colour.g, colour.b, colour.a};
+  aiString texture;
+  if (material.GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == AI_SUCCESS ||
+      material.GetTexture(aiTextureType_DIFFUSE, 0, &texture) == AI_SUCCESS)
+    out.base_color_texture = texture.C_Str();
+  return out;
+}
+
+Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d out;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out(r, c) = m[r][c];
+  return out;
+}
+
+class SceneBuilder {
+ public:
+  SceneBuilder(const aiScene& ai, const SceneReadOptions& options)
+      : ai_(ai), normal_weld_cos_(std::cos(options.normal_weld_degrees * 3.14159265358979323846 / 180.0)) {}
+
+  Scene build() {
+    for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.materials.push_back(read_material(*ai_.mMaterials[i], i));
+    if (ai_.mRootNode) add_node(*ai_.mRootNode, kInvalidIndex);
+    scene_.cameras = ai_.mNumCameras;
+    scene_.lights = ai_.mNumLights;
+    scene_.animations = ai_.mNumAnimations;
+    scene_extras();
+    return std::move(scene_);
+  }
+
+ private:
+  void add_node(const aiNode& node, Index parent) {
+    const Index id = static_cast<Index>(scene_.nodes.size());
+    SceneNode out;
+    out.name = node.mName.C_Str();
+    out.parent = parent;
+    out.local = to_eigen(node.mTransformation);
+    std::vector<unsigned> group;
+    for (unsigned i = 0; i < node.mNumMeshes; ++i)
+      if (node.mMeshes[i] < ai_.mNumMeshes) group.push_back(node.mMeshes[i]);
+    const std::vector<const aiNode*> folded = per_material_children(node);
+    for (const aiNode* child : folded)
+      for (unsigned i = 0; i < child->mNumMeshes; ++i)
+        if (child->mMeshes[i] < ai_.mNumMeshes) group.push_back(child->mMeshes[i]);
+    std::sort(group.begin(), group.end());
+    group.erase(std::unique(group.begin(), group.end()), group.end());
+    scene_.nodes.push_back(std::move(out));
+    if (!group.empty()) {
+      const Index mesh = mesh_of_group(group, node);
+      if (mesh != kInvalidIndex) scene_.nodes[id].meshes.push_back(mesh);
+    }
+    for (unsigned i = 0; i < node.mNumChildren; ++i)
+      if (std::find(folded.begin(), folded.end(), node.mChildren[i]) == folded.end()) add_node(*node.mChildren[i], id);
+  }
+
+  /// assimp's FBX exporter (and so our .fbx files) moves the meshes of a node with several
+  /// materials into one child node per material, all named after the mesh, identity transform,
+  /// no children of their own:  grid_a → {grid (red), grid (blue)}. Read back as they are, the
+  /// mesh would come apart at its material borders. Such children (two or more, one shared
+  /// name, under a node without meshes) are folded back into their parent's mesh.
+  std::vector<const aiNode*> per_material_children(const aiNode& node) const {
+    std::vector<const aiNode*> children;
+    if (node.mNumMeshes > 0) return children;
+    for (unsigned i = 0; i < node.mNumChildren; ++i) {
+      const aiNode* c = node.mChildren[i];
+      if (c->mNumChildren > 0 || c->mNumMeshes == 0 || !c->mTransformation.IsIdentity()) continue;
+      bool named_after_mesh = true;
+      for (unsigned k = 0; k < c->mNumMeshes; ++k)
+        named_after_mesh = named_after_mesh && c->mMeshes[k] < ai_.mNumMeshes &&
+                           ai_.mMeshes[c->mMeshes[k]]->mName == c->mName;
+      if (named_after_mesh && (children.empty() || children[0]->mName == c->mName)) children.push_back(c);
+    }
+    if (children.size() < 2) children.clear();
+    return children;
+  }
+
+  /// The Scene mesh of a node's set of aiMeshes; the same set in another node is an instance.
+  Index mesh_of_group(const std::vector<unsigned>& group, const aiNode& node) {
+    if (auto it = mesh_of_group_.find(group); it != mesh_of_group_.end()) return it->second;
+    SceneMesh out;
+    // The aiMeshes' name when they share one (a mesh split by material), else the node's.
+    out.name = ai_.mMeshes[group[0]]->mName.C_Str();
+    for (unsigned m : group)
+      if (ai_.mMeshes[m]->mName != ai_.mMeshes[group[0]]->mName) out.name.clear();
+    if (out.name.empty()) out.name = node.mName.C_Str();
+    weld(group, out.mesh);
+    Index id = kInvalidIndex;
+    if (out.mesh.num_faces() > 0) {
+      for (unsigned m : group) per_mesh_extras(*ai_.mMeshes[m], out);
+      id = static_cast<Index>(scene_.meshes.size());
+      scene_.meshes.push_back(std::move(out));
+    }
+    mesh_of_group_.emplace(group, id);
+    return id;
+  }
+
+  /// The meshes of `group` as one PolyMesh (see the file comment): gather the faces, decide
+  /// which corners are one vertex (glue_corners), then build pools and faces.
+  void weld(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    unsigned uv_sets = 0;
+    bool normals = false, colours = false;
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      uv_sets = std::max(uv_sets, a.GetNumUVChannels());
+      normals = normals || a.HasNormals();
+      colours = colours || a.HasVertexColors(0);
+    }
+    Corners corners = gather_corners(group);
+    Index vertex_count = 0;
+    const std::vector<Index> vertex_of = glue_corners(corners, vertex_count);
+
+    mesh.positions.resize(vertex_count);
+    std::vector<char> placed(vertex_count, 0);
+    if (colours) mesh.vertex_colors.assign(vertex_count, Vec3(1, 1, 1));
+    mesh.uv_sets.resize(uv_sets);
+    std::vector<Pool<Vec2>> uv_pools(uv_sets);
+    for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
+    Pool<Vec3> normal_pool{&mesh.normals, {}};
+    std::vector<std::vector<Index>> normals_at(vertex_count);  // per vertex: the normal entries its corners use
+    std::map<std::string, Index> material_of;
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      for (unsigned k = 0; k < uv_sets; ++k)
+        if (mesh.uv_sets[k].name.empty() && a.HasTextureCoordsName(k))
+          mesh.uv_sets[k].name = a.mTextureCoordsNames[k]->C_Str();
+    }
+    for (std::size_t f = 0; f + 1 < corners.face_offsets.size(); ++f) {
+      const Index begin = corners.face_offsets[f], end = corners.face_offsets[f + 1];
+      // Gluing can (rarely) bring two corners of one face onto one vertex: such a face is dropped.
+      bool repeated = false;
+      for (Index c = begin; c < end && !repeated; ++c)
+        for (Index d = c + 1; d < end && !repeated; ++d) repeated = vertex_of[c] == vertex_of[d];
+      if (repeated) {
+        ++scene_.dropped_primitives;
+        continue;
+      }
+      const aiMesh& a = *ai_.mMeshes[corners.mesh[begin]];
+      for (Index c = begin; c < end; ++c) {
+        const unsigned v = corners.vertex[c];
+        const Index w = vertex_of[c];
+        if (!placed[w]) {
+          placed[w] = 1;
+          mesh.positions[w] = Vec3(a.mVertices[v].x, a.mVertices[v].y, a.mVertices[v].z);
+          if (colours && a.HasVertexColors(0)) {
+            const aiColor4D& col = a.mColors[0][v];
+            mesh.vertex_colors[w] = Vec3(col.r, col.g, col.b);
+          }
+        }
+        mesh.corner_vertex.push_back(w);
+        for (unsigned k = 0; k < uv_sets; ++k) {
+          Index uv = kInvalidIndex;
+          if (a.HasTextureCoords(k)) {
+            const aiVector3D& t = a.mTextureCoords[k][v];
+            uv = uv_pools[k].add(key_of(t.x, t.y, 0.0f), Vec2(t.x, t.y));
+          }
+          mesh.uv_sets[k].corner.push_back(uv);
+        }
+        if (normals) {
+          Index n = kInvalidIndex;
+          if (a.HasNormals()) {
+            const aiVector3D& t = a.mNormals[v];
+            n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
+            n = weld_normal(mesh.normals, normals_at[w], n);
+          }
+          mesh.corner_normal.push_back(n);
+        }
+      }
+      mesh.face_offsets.push_back(mesh.num_corners());
+      if (!scene_.materials.empty()) {
+        Index material = kInvalidIndex;
+        if (a.mMaterialIndex < scene_.materials.size()) {
+          const std::string& name = scene_.materials[a.mMaterialIndex].name;
+          auto [it, inserted] = material_of.try_emplace(name, static_cast<Index>(mesh.material_names.size()));
+          if (inserted) mesh.material_names.push_back(name);
+          material = it->second;
+        }
+        mesh.face_material.push_back(material);
+      }
+    }
+    // Vertices only used by dropped faces: compact them away.
+    compact_unused(mesh, placed);
+  }
+
+  /// The faces of a group's aiMeshes as corners: which aiMesh, which of its vertices, which
+  /// distinct position. Consecutive corners on one position are merged; faces that still use a
+  /// position twice or have fewer than 3 corners are dropped (counted).
+  struct Corners {
+    std::vector<unsigned> mesh, vertex;
+    std::vector<Index> position;
+    std::vector<Index> face_offsets{0};
+  };
+  Corners gather_corners(const std::vector<unsigned>& group) {
+    Corners out;
+    std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
+    std::vector<unsigned> face;
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      std::vector<Index> position(a.mNumVertices);
+      for (unsigned v = 0; v < a.mNumVertices; ++v) {
+        const aiVector3D& p = a.mVertices[v];
+        position[v] = position_of.try_emplace(key_of(p.x, p.y, p.z), static_cast<Index>(position_of.size())).first->second;
+      }
+      for (unsigned f = 0; f < a.mNumFaces; ++f) {
+        const aiFace& af = a.mFaces[f];
+        face.clear();
+        for (unsigned c = 0; c < af.mNumIndices; ++c) {
+          const unsigned v = af.mIndices[c];
+          if (v >= a.mNumVertices) { face.clear(); break; }
+          if (!face.empty() && position[face.back()] == position[v]) continue;
+          face.push_back(v);
+        }
+        while (face.size() > 1 && position[face.front()] == position[face.back()]) face.pop_back();
+        bool repeated = face.size() < 3;
+        for (std::size_t i = 0; i < face.size() && !repeated; ++i)
+          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = position[face[i]] == position[face[j]];
+        if (repeated) {
+          ++scene_.dropped_primitives;
+          continue;
+        }
+        for (unsigned v : face) {
+          out.mesh.push_back(m);
+          out.vertex.push_back(v);
+          out.position.push_back(position[v]);
+        }
+        out.face_offsets.push_back(static_cast<Index>(out.position.size()));
+      }
+    }
+    return out;
+  }
+
+  /// Which corners are one vertex. Corners sharing an aiMesh vertex are (the file says so). Then
+  /// the surface is glued along its edges, not at its points:
+  ///
+  ///     face A  a0 ──► a1          two half-edges on the same two positions, running opposite
+  ///             b1 ◄── b0  face B  ways: A and B are neighbours, a0 ~ b1 and a1 ~ b0
+  ///
+  /// so a seam the exporter split comes back, while parts that only touch at a point, or lie on
+  /// top of each other, stay apart — welding by position would join them into non-manifold
+  /// vertices and edges, and doubled surfaces into repeated faces. Where more than two half-edges
+  /// share a position pair, each pairs with the first later opposite one in file order (a doubled
+  /// card: its own faces come next to each other). Half-edges running the same way are not
+  /// glued: that is how the boundaries of a doubled card meet, and the price is that a neighbour
+  /// with the opposite orientation comes back across a crack (two boundary edges) where the
+  /// source had one inconsistently oriented edge. Returns a vertex per corner, numbered by first
+  /// corner.
+  std::vector<Index> glue_corners(const Corners& corners, Index& vertex_count) const {
+    const Index n = static_cast<Index>(corners.position.size());
+    UnionFind sets(n);
+    std::unordered_map<std::uint64_t, Index> first_use;  // (aiMesh, vertex) → corner
+    for (Index c = 0; c < n; ++c) {
+      const std::uint64_t key = std::uint64_t{corners.mesh[c]} << 32 | corners.vertex[c];
+      const auto [it, inserted] = first_use.try_emplace(key, c);
+      if (!inserted) sets.unite(it->second, c);
+    }
+    // Half-edge c runs from corner c to the next corner of its face.
+    std::vector<Index> next(n);
+    for (std::size_t f = 0; f + 1 < corners.face_offsets.size(); ++f)
+      for (Index c = corners.face_offsets[f]; c < corners.face_offsets[f + 1]; ++c)
+        next[c] = c + 1 == corners.face_offsets[f + 1] ? corners.face_offsets[f] : c + 1;
+    std::unordered_map<std::uint64_t, std::vector<Index>> half_edges;  // position pair → half-edges, file order
+    for (Index c = 0; c < n; ++c) {
+      const Index p = corners.position[c], q = corners.position[next[c]];
+      half_edges[std::uint64_t{std::min(p, q)} << 32 | std::max(p, q)].push_back(c);
+    }
+    const auto glue = [&](Index c, Index d) {  // c runs p → q, d runs q → p
+      sets.unite(c, next[d]);
+      sets.unite(next[c], d);
+    };
+    std::vector<char> paired;
+    for (const auto& [key, list] : half_edges) {
+      if (list.size() < 2) continue;
+      paired.assign(list.size(), 0);
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        if (paired[i]) continue;
+        for (std::size_t j = i + 1; j < list.size(); ++j)
+          if (!paired[j] && corners.position[list[j]] == corners.position[next[list[i]]]) {
+            glue(list[i], list[j]);
+            paired[i] = paired[j] = 1;
+            break;
+          }
+      }
+    }
+    return sets.dense_labels(vertex_count);
+  }
+
+  /// Drops the vertices no kept face uses (`used` per vertex) and renumbers the corners.
+  static void compact_unused(PolyMesh& mesh, const std::vector<char>& used) {
+    if (std::all_of(used.begin(), used.end(), [](char u) { return u != 0; })) return;
+    std::vector<Index> new_id(used.size(), kInvalidIndex);
+    Index count = 0;
+    for (std::size_t v = 0; v < used.size(); ++v)
+      if (used[v]) {
+        new_id[v] = count;
+        mesh.positions[count] = mesh.positions[v];
+        if (!mesh.vertex_colors.empty()) mesh.vertex_colors[count] = mesh.vertex_colors[v];
+        ++count;
+      }
+    mesh.positions.resize(count);
+    if (!mesh.vertex_colors.empty()) mesh.vertex_colors.resize(count);
+    for (Index& v : mesh.corner_vertex) v = new_id[v];
+  }
+
+  /// The normal entry a corner of a vertex uses: an entry another corner of that vertex already
+  /// uses when it lies within the weld angle (SceneReadOptions::normal_weld_degrees), else `n`.
+  Index weld_normal(const std::vector<Vec3>& pool, std::vector<Index>& at_vertex, Index n) const {
+    for (Index used : at_vertex) {
+      if (used == n) return n;
+      const double lengths = pool[used].norm() * pool[n].norm();
+      if (lengths > 0 && pool[used].dot(pool[n]) >= normal_weld_cos_ * lengths) return used;
+    }
+    at_vertex.push_back(n);
+    return n;
+  }
+
+  /// Issue 24: bones and weights of aiMesh `a` go into `out` here. An aiMesh vertex v lands on
+  /// the welded vertex of its position (on the layer of the faces using it, see weld()): record
+  /// that map in weld() next to `chosen` when the weights need it.
+  void per_mesh_extras(const aiMesh& a, SceneMesh& out) {}
+  /// Issue 24: skeleton (nodes already read) and ai_.mAnimations go here.
+  void scene_extras() {}
+
+  const aiScene& ai_;
+  const double normal_weld_cos_;
+  Scene scene_;
+  std::map<std::vector<unsigned>, Index> mesh_of_group_;
+};
+
+/// The post-processing steps: checks, and points / lines removed — nothing that triangulates,
+/// joins vertices or reorders faces.
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
+
+void configure(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // FBX pivots as separate "$AssimpFbx$" helper nodes would change the hierarchy on a round trip.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+}
+
+SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
+                       const SceneReadOptions& options) {
+  SceneReadResult result;
+  if (!ai) {
+    std::string message = importer.GetErrorString();
+    if (message.empty()) message = "unreadable scene";
+    result.error = name + ": assimp: " + message;
+    return result;
+  }
+  result.scene = SceneBuilder(*ai, options).build();
+  return result;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+namespace io_detail {
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const SceneReadOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    SceneReadResult result;
+    result.error = "cannot read " + path.string() + ": " +
+                   (std::filesystem::exists(path, ec) ? "not a regular file" : "No such file or directory");
+    return result;
+  }
+  Assimp::Importer importer;
+  configure(importer);
+  const aiScene* ai = importer.ReadFile(path.string(), kImportSteps);
+  SceneReadResult result = finish(ai, importer, path.string(), options);
+  result.seconds = seconds_since(start);
+  return result;
+}
+}  // namespace io_detail
+
+SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::string_view hint,
+                                       const std::string& name, const SceneReadOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Assimp::Importer importer;
+  configure(importer);
+  const std::string hint_text(hint);
+  const aiScene* ai = size == 0 ? nullptr : importer.ReadFileFromMemory(data, size, kImportSteps, hint_text.c_str());
+  SceneReadResult result;
+  if (size == 0)
+    result.error = name + ": empty buffer";
+  else
+    result = finish(ai, importer, name, options);
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace quadlod
