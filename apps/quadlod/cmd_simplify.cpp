@@ -2,6 +2,7 @@
 #include "commands.h"
 
 #include "quadlod/io.h"
+#include "skin_cli.h"
 #include "quadlod/simplify.h"
 #include "util/progress.h"
 
@@ -21,6 +22,7 @@ struct SimplifyCliOptions {
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false;
+  std::string rig, glb;  // issue 24: skinned input / skinned .glb output
 };
 
 }  // namespace
@@ -115,6 +117,14 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
   sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
+  sub->add_option("--rig", opt->rig,
+                  "Skinned glTF whose skeleton and animations drive the mesh; an INPUT without weights takes "
+                  "them from its mesh by projection (docs/skinning.md)");
+  sub->add_option("--glb", opt->glb, "Also write the LOD as a skinned .glb with the rig's skeleton and animations");
+  sub->add_option("--skin-border", p.skin_border_distance,
+                  "Keep edges whose endpoints' weights differ by more than this and follow unrelated bones (> 1 = off)")
+      ->check(CLI::Range(0.0, 2.0))
+      ->capture_default_str();
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
   return {sub, [opt, ratio, faces, &global]() -> int {
             if (ratio->count() == 0 && faces->count() == 0) {
@@ -126,14 +136,20 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                 return fail(out + ": refusing to overwrite the input");
             if (!opt->report.empty() && same_file(opt->output, opt->report))
               return fail(opt->report + ": the report and the output are the same file");
+            for (const std::string& out : {opt->glb})
+              if (!out.empty() && (same_file(opt->input, out) || same_file(opt->rig, out)))
+                return fail(out + ": refusing to overwrite an input");
             MeshFormat format;
             if (!format_from_path(opt->output, format))
               return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
             Stopwatch clock;
-            const ReadResult in = read_mesh(opt->input);
-            if (!in.ok()) return fail(in.error);
+            const SkinnedInput in = read_skinned_input(opt->input, opt->rig);
+            if (!in.error.empty()) return fail(in.error);
+            if (!opt->glb.empty() && (in.rig.empty() || in.mesh.skin.empty()))
+              return fail(opt->input + ": --glb needs a skinned input (a skinned glTF, or --rig)");
             const double read_seconds = clock.seconds();
             SimplifyOptions p = opt->pipeline;
+            for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
             p.exact_formulation = opt->formulation == "exact";
@@ -154,6 +170,11 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             const WriteResult written = write_mesh(r.mesh, opt->output);
             if (!written.ok()) return fail(written.error);
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+            if (!opt->glb.empty()) {
+              const WriteResult glb = write_skinned_glb(r.mesh, in.rig, opt->glb, in.material_colors);
+              if (!glb.ok()) return fail(glb.error);
+              r.report["glb"] = opt->glb;
+            }
             const double write_seconds = clock.seconds();
             r.report["input"] = opt->input;
             r.report["output"] = opt->output;

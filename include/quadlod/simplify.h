@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace quadlod {
 
@@ -113,6 +114,18 @@ struct SimplifyOptions {
   /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7
   /// did; false = by their quadric (ClusterCollapseParams::place_on_hard_edges, measured).
   bool place_on_hard_edges = false;
+
+  // --- skinning (issue 24; docs/skinning.md) ----------------------------------------------------
+  /// With a skinned input (PolyMesh::skin): the output gets weights by projection onto the input
+  /// (transfer_skin_weights, include/quadlod/skin.h), and an edge is kept by the selection when
+  /// its endpoints follow unrelated bones — weight_distance() above `skin_border_distance` and
+  /// their dominant joints neither equal nor parent and child — so no cluster merges across it.
+  /// > 1 = off. 0.5: more than half of the weight changes hands across one edge, which smooth
+  /// skinning never does between neighbours (ram: docs/skinning.md) but a rigid split does.
+  double skin_border_distance = 0.5;
+  /// The skeleton's parent per joint (kInvalidIndex for roots), which says which joints are
+  /// related; empty = no two distinct joints are related.
+  std::vector<Index> skin_joint_parents;
 
   // --- guarantees -------------------------------------------------------------------------------
   /// Bound on the distance of moved vertices from the input, relative to the bounding-box
