@@ -75,6 +75,10 @@ def main():
     ap.add_argument("--single", default=os.environ.get("QUADLOD_SINGLE", SINGLE))
     ap.add_argument("--glb", default=os.path.join(CORPUS, "yofrankie_ram_walk.glb"))
     ap.add_argument("--rest", default=os.path.join(CORPUS, "yofrankie_ram_rest.obj"))
+    ap.add_argument("--quadlod-input", choices=["clean", "full"], default="clean",
+                    help="what quadlod reduces: clean = the positions-and-polygons OBJ Single gets (default, as "
+                         "bench/run.py), full = the rest OBJ with UVs, normals and materials (their seams kept)")
+    ap.add_argument("--quadlod-args", default="", help="extra arguments for quadlod simplify (one string)")
     ap.add_argument("--no-blender", action="store_true", help="skip the Blender re-import of the LOD glb")
     a = ap.parse_args()
     os.makedirs(os.path.join(a.out, "work"), exist_ok=True)
@@ -84,15 +88,16 @@ def main():
     stripped = os.path.join(a.out, "work", "ram_rest.vf.obj")
     write_stripped_obj(a.rest, stripped)
     n0 = tri_equivalents(a.rest)
-    results = {"input": a.rest, "rig": a.glb, "tri_equivalent_in": n0, "samples": a.samples, "runs": []}
+    results = {"input": a.rest, "rig": a.glb, "quadlod_input": a.quadlod_input, "quadlod_args": a.quadlod_args, "tri_equivalent_in": n0, "samples": a.samples, "runs": []}
     for ratio in a.ratios:
         target = max(1, int(round(ratio * n0)))
         tag = "%g" % ratio
         lods = []
         q_obj = os.path.join(a.out, "quadlod_%s.obj" % tag)
         q_glb = os.path.join(a.out, "quadlod_%s.glb" % tag)
-        out, secs = run([a.quadlod, "-q", "simplify", a.rest, "-o", q_obj, "--glb", q_glb, "--rig", a.glb,
-                         "--faces", str(target), "--report", os.path.join(a.out, "quadlod_%s.report.json" % tag)],
+        q_in = stripped if a.quadlod_input == "clean" else a.rest
+        out, secs = run([a.quadlod, "-q", "simplify", q_in, "-o", q_obj, "--glb", q_glb, "--rig", a.glb,
+                         "--faces", str(target), "--report", os.path.join(a.out, "quadlod_%s.report.json" % tag)] + a.quadlod_args.split(),
                         os.path.join(a.out, "quadlod_%s.log" % tag))
         lods.append(("quadlod", q_obj, secs))
         if have_single:
@@ -137,6 +142,8 @@ def blender_check(a, glb):
 
 def write_table(a, results):
     lines = ["# Fig. 10 on the ram walk (%s, %d frames)" % (os.path.basename(a.glb), len(results["runs"][0]["frames"])), "",
+             "quadlod input: %s%s; Single: the clean OBJ (positions and polygons)." % (
+                 a.quadlod_input, (" with `%s`" % a.quadlod_args) if a.quadlod_args else ""), "",
              "Per-frame metrics between the posed input and the posed LOD (normalised by the posed input's bbox);",
              "median and worst frame over the walk. Both LODs take weights by projection onto the input.", "",
              "| ratio | method | tri-eq | quads/tris | " + " | ".join("%s median | %s worst" % (n, n) for _, n in METRICS) + " |",

@@ -220,3 +220,43 @@ print("RESULT armatures=%d bones=%d modifiers=%d actions=%d first=%g last=%g mov
 
 }  // namespace
 }  // namespace quadlod
+
+#include "quadlod/scene.h"
+
+namespace quadlod {
+namespace {
+
+// Issue 21's assimp scene reader fills the same weights and rig (glTF skins here; FBX clusters
+// take the same aiBone path): against the project's own glTF reader on the test rig.
+TEST_F(SkinIo, AssimpSceneReaderReadsTheSkinAndRig) {
+  const SkinnedMesh tube = make_bending_tube(10, 12, 3);
+  const fs::path file = dir / "tube.glb";
+  ASSERT_TRUE(write_skinned_glb(tube.mesh, tube.rig, file).ok());
+  const SceneReadResult r = read_scene(file);
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  const PolyMesh& m = r.scene.meshes[0].mesh;
+  ASSERT_EQ(m.check_layout(), "");
+  ASSERT_EQ(m.num_vertices(), tube.mesh.num_vertices());
+  ASSERT_FALSE(m.skin.empty());
+  const Skeleton& s = r.scene.rig.skeleton;
+  ASSERT_EQ(s.check(), "");
+  ASSERT_EQ(s.num_joints(), 3u);
+  ASSERT_EQ(r.scene.rig.animations.size(), 1u);
+  EXPECT_EQ(r.scene.rig.animations[0].frame_times().size(), 12u);
+  // Posed at the last frame, every vertex lands where the generator's rig puts it (joints matched
+  // by name, vertices by bind position).
+  const double t = tube.rig.animations[0].end_time();
+  const auto expected = posed_positions(tube.mesh, tube.rig, t);
+  const auto got = posed_positions(m, r.scene.rig, t);
+  for (Index v = 0; v < m.num_vertices(); ++v) {
+    Index u = kInvalidIndex;
+    for (Index k = 0; k < tube.mesh.num_vertices(); ++k)
+      if ((tube.mesh.positions[k] - m.positions[v]).norm() < 1e-6) u = k;
+    ASSERT_NE(u, kInvalidIndex);
+    ASSERT_NEAR((expected[u] - got[v]).norm(), 0.0, 1e-4) << "vertex " << v;
+  }
+}
+
+}  // namespace
+}  // namespace quadlod

@@ -22,6 +22,7 @@ struct SimplifyCliOptions {
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false;
+  bool per_mesh = false;
   std::string rig, glb;  // issue 24: skinned input / skinned .glb output
 };
 
@@ -30,8 +31,8 @@ struct SimplifyCliOptions {
 Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   auto opt = std::make_shared<SimplifyCliOptions>();
   CLI::App* sub = app.add_subcommand("simplify", "Reduce a quad-dominant mesh, keeping its edge loops");
-  sub->add_option("INPUT", opt->input, "Input mesh (.obj, .ply, .off)")->required();
-  sub->add_option("-o,--output", opt->output, "Output mesh (.obj, .ply, .off)")->required();
+  sub->add_option("INPUT", opt->input, "Input mesh (.obj, .ply, .off) or scene (.fbx, .glb, .gltf, .dae, .3ds, ...)")->required();
+  sub->add_option("-o,--output", opt->output, "Output mesh (.obj, .ply, .off) or scene (.glb, .fbx, .dae)")->required();
   auto* ratio = sub->add_option("--ratio", opt->ratio, "Target as a fraction of the input's triangle-equivalents")
                     ->check(CLI::Range(1e-6, 1.0))
                     ->group("Target (one of)");
@@ -40,6 +41,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                     ->group("Target (one of)");
   ratio->excludes(faces);
   faces->excludes(ratio);
+  sub->add_flag("--per-mesh", opt->per_mesh,
+                "Scenes: the target applies to each mesh (default: the scene's target, split by triangle-equivalents)")
+      ->group("Target (one of)");
   SimplifyOptions& p = opt->pipeline;
   sub->add_option("--objective", p.objective,
                   "shape (the geometric error of the output, deterministic greedy) or paper (Eq. 9 with the MIP search)")
@@ -139,17 +143,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             for (const std::string& out : {opt->glb})
               if (!out.empty() && (same_file(opt->input, out) || same_file(opt->rig, out)))
                 return fail(out + ": refusing to overwrite an input");
-            MeshFormat format;
-            if (!format_from_path(opt->output, format))
-              return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
-            Stopwatch clock;
-            const SkinnedInput in = read_skinned_input(opt->input, opt->rig);
-            if (!in.error.empty()) return fail(in.error);
-            if (!opt->glb.empty() && (in.rig.empty() || in.mesh.skin.empty()))
-              return fail(opt->input + ": --glb needs a skinned input (a skinned glTF, or --rig)");
-            const double read_seconds = clock.seconds();
             SimplifyOptions p = opt->pipeline;
-            for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
             p.exact_formulation = opt->formulation == "exact";
@@ -161,13 +155,43 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.greedy_fallback = !opt->no_greedy_fallback;
             p.features = !opt->no_features;
             p.progress = !global.quiet;
+            // Skinned meshes (issue 24) take their own path: --rig / --glb, or a skinned glTF input
+            // (its skin, skeleton and animations carried through; a .glb output is written skinned).
+            Stopwatch clock;
+            SkinnedInput in;
+            bool skinned = !opt->rig.empty() || !opt->glb.empty();
+            if (!skinned && is_gltf_path(opt->input)) {
+              in = read_skinned_input(opt->input, "");
+              skinned = in.error.empty();
+            } else if (skinned) {
+              in = read_skinned_input(opt->input, opt->rig);
+              if (!in.error.empty()) return fail(in.error);
+            }
+            MeshFormat format, input_format;
+            const bool native_out = format_from_path(opt->output, format);
+            const bool glb_out = skinned && is_gltf_path(opt->output);
+            // Scenes (FBX, glTF, Collada, … on either side) go mesh by mesh (cmd_scene.cpp).
+            if (!skinned && (!native_out || !format_from_path(opt->input, input_format)))
+              return simplify_scene_file(opt->input, opt->output, opt->report, p, opt->per_mesh);
+            if (skinned && !native_out && !glb_out)
+              return fail(opt->output + ": a skinned mesh is written as .glb (or .obj / .ply / .off without its skin)");
+            if ((!opt->glb.empty() || glb_out) && (in.rig.empty() || in.mesh.skin.empty()))
+              return fail(opt->input + ": a skinned .glb output needs a skinned input (a skinned glTF, or --rig)");
+            if (!skinned) {
+              ReadResult plain = read_mesh(opt->input);
+              if (!plain.ok()) return fail(plain.error);
+              in.mesh = std::move(plain.mesh);
+            }
+            for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
+            const double read_seconds = clock.seconds();
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);
             // The output may live elsewhere: keep its `mtllib` lines pointing at the input's MTL.
             for (const std::string& w : rebase_material_libraries(r.mesh, opt->input, opt->output))
               std::fprintf(stderr, "warning: %s\n", w.c_str());
             clock = Stopwatch();
-            const WriteResult written = write_mesh(r.mesh, opt->output);
+            const WriteResult written = glb_out ? write_skinned_glb(r.mesh, in.rig, opt->output, in.material_colors)
+                                                : write_mesh(r.mesh, opt->output);
             if (!written.ok()) return fail(written.error);
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             if (!opt->glb.empty()) {

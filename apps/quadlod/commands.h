@@ -9,6 +9,10 @@
 #include <functional>
 #include <string>
 
+namespace quadlod {
+struct SimplifyOptions;
+}  // namespace quadlod
+
 namespace quadlod::cli {
 
 /// Exit codes, documented in README.md ("CLI reference").
@@ -34,6 +38,13 @@ Command add_eval(CLI::App& app, const GlobalOptions& global);
 Command add_generate(CLI::App& app, const GlobalOptions& global);
 Command add_simplify(CLI::App& app, const GlobalOptions& global);
 Command add_analyze(CLI::App& app, const GlobalOptions& global);
+Command add_lod(CLI::App& app, const GlobalOptions& global);
+Command add_batch(CLI::App& app, const GlobalOptions& global);
+
+/// `quadlod simplify` on a scene (either side not OBJ / PLY / OFF): read_scene, simplify_scene,
+/// write_scene; prints one summary line (cmd_scene.cpp).
+int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
+                        const SimplifyOptions& options, bool per_mesh);
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
       add_eval(app, global),
       add_analyze(app, global),
       add_generate(app, global),
+      add_lod(app, global),
+      add_batch(app, global),
   };
 
   try {

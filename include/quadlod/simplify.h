@@ -120,8 +120,8 @@ struct SimplifyOptions {
   /// (transfer_skin_weights, include/quadlod/skin.h), and an edge is kept by the selection when
   /// its endpoints follow unrelated bones — weight_distance() above `skin_border_distance` and
   /// their dominant joints neither equal nor parent and child — so no cluster merges across it.
-  /// > 1 = off. 0.5: more than half of the weight changes hands across one edge, which smooth
-  /// skinning never does between neighbours (ram: docs/skinning.md) but a rigid split does.
+  /// > 1 = off. 0.5: more than half of the weight changes hands across one edge (a rigid split;
+  /// on the ram 17 quad edges between unrelated bones, docs/skinning.md).
   double skin_border_distance = 0.5;
   /// The skeleton's parent per joint (kInvalidIndex for roots), which says which joints are
   /// related; empty = no two distinct joints are related.

@@ -102,6 +102,8 @@ nlohmann::json to_json(const AnimationEvalResult& r) {
                       {"pccd", f.metrics.pccd_defined ? num(f.metrics.pccd) : nlohmann::json()},
                       {"chamfer", num(f.metrics.chamfer)},
                       {"hausdorff", num(f.metrics.hausdorff)},
+                      {"hausdorff_in_to_out", num(f.metrics.hausdorff_in_to_out)},
+                      {"hausdorff_out_to_in", num(f.metrics.hausdorff_out_to_in)},
                       {"flow_deviation_deg", num(f.metrics.flow_deviation_deg)},
                       {"flow_coverage", num(f.metrics.flow_coverage)},
                       {"flipped_faces", f.metrics.flipped_faces}});

@@ -1,0 +1,102 @@
+// `quadlod batch (FOLDER -o OUTDIR | MANIFEST.jsonl) [--ratio R | --faces N | --levels … | --count K]
+// [--format EXT] [--shard I/N] [--force]`: many assets, one JSON line each (docs/batch.md).
+#include "commands.h"
+
+#include "quadlod/batch.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace quadlod::cli {
+
+namespace {
+
+struct BatchCliOptions {
+  std::string source, output_dir, format, shard = "0/1";
+  double ratio = 0.0;
+  std::uint64_t faces = 0;
+  std::vector<double> levels;
+  int count = 0;
+  bool per_mesh = false, force = false, no_features = false;
+  std::string objective;
+  int threads = -1;
+};
+
+}  // namespace
+
+Command add_batch(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<BatchCliOptions>();
+  CLI::App* sub = app.add_subcommand("batch", "Reduce many assets (a folder or a JSON-lines manifest); one JSON line per asset");
+  sub->add_option("SOURCE", opt->source, "A folder of assets, or a manifest (.jsonl: input, output, options per line)")->required();
+  sub->add_option("-o,--output", opt->output_dir, "Output folder (folder mode)");
+  auto* ratio = sub->add_option("--ratio", opt->ratio, "Default target ratio")->check(CLI::Range(1e-6, 1.0))->group("Default target (one of)");
+  auto* faces = sub->add_option("--faces", opt->faces, "Default target triangle-equivalents")->group("Default target (one of)");
+  auto* levels = sub->add_option("--levels", opt->levels, "Default: a LOD chain with these ratios")
+                     ->delimiter(',')->check(CLI::Range(1e-6, 0.999999))->group("Default target (one of)");
+  auto* count = sub->add_option("--count", opt->count, "Default: a LOD chain of this many levels, each half the previous")
+                    ->check(CLI::Range(1, 16))->group("Default target (one of)");
+  for (CLI::Option* a : {ratio, faces, levels, count})
+    for (CLI::Option* b : {ratio, faces, levels, count})
+      if (a != b) a->excludes(b);
+  sub->add_option("--format", opt->format, "Output format of folder mode / LOD files (default: the input's, else glb)")
+      ->check(CLI::IsMember({"glb", "obj", "fbx", "dae", "ply", "off"}));
+  sub->add_flag("--per-mesh", opt->per_mesh, "Scenes: the target applies to each mesh");
+  sub->add_option("--objective", opt->objective, "shape or paper")->check(CLI::IsMember({"shape", "paper"}));
+  sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
+  sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
+  sub->add_option("--shard", opt->shard,
+                  "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
+                  "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT or $JOB_COMPLETION_INDEX/N")
+      ->capture_default_str();
+  sub->add_flag("--force", opt->force, "Redo assets whose outputs are newer than their inputs");
+  return {sub, [opt, ratio, faces, levels, count, &global]() -> int {
+            unsigned shard = 0, shards = 1;
+            if (!parse_shard(opt->shard, shard, shards)) {
+              std::fprintf(stderr, "quadlod batch: --shard wants I/N with 0 <= I < N, got '%s'\n", opt->shard.c_str());
+              return kExitUsage;
+            }
+            nlohmann::json defaults = nlohmann::json::object();
+            if (ratio->count()) defaults["ratio"] = opt->ratio;
+            if (faces->count()) defaults["faces"] = opt->faces;
+            if (levels->count()) defaults["levels"] = opt->levels;
+            if (count->count()) defaults["count"] = opt->count;
+            if (opt->per_mesh) defaults["per_mesh"] = true;
+            if (!opt->objective.empty()) defaults["objective"] = opt->objective;
+            if (opt->threads >= 0) defaults["threads"] = opt->threads;
+            if (opt->no_features) defaults["features"] = false;
+            const bool folder = std::filesystem::is_directory(opt->source);
+            if (folder && opt->output_dir.empty()) {
+              std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");
+              return kExitUsage;
+            }
+            if (folder && defaults.size() == 0) {
+              std::fprintf(stderr, "quadlod batch: give a target: --ratio, --faces, --levels or --count\n");
+              return kExitUsage;
+            }
+            if (!opt->format.empty() && !folder) defaults["format"] = opt->format;
+            const BatchPlan plan = folder ? plan_batch_folder(opt->source, opt->output_dir, opt->format, defaults)
+                                          : plan_batch_manifest(opt->source, defaults);
+            if (!plan.ok()) return fail(plan.error);
+            BatchRunParams params;
+            params.force = opt->force;
+            params.progress = false;
+            (void)global;
+            std::size_t failures = 0, done = 0, skipped = 0;
+            const std::vector<BatchJob> jobs = shard_jobs(plan.jobs, shard, shards);
+            for (const BatchJob& job : jobs) {
+              const nlohmann::json line = run_batch_job(job, params);
+              const std::string status = line["status"].get<std::string>();
+              failures += status == "failed";
+              done += status == "done";
+              skipped += status == "skipped";
+              std::printf("%s\n", line.dump().c_str());
+              std::fflush(stdout);
+            }
+            if (!global.quiet)
+              std::fprintf(stderr, "batch: shard %u/%u, %zu of %zu assets: %zu done, %zu skipped, %zu failed\n", shard,
+                           shards, jobs.size(), plan.jobs.size(), done, skipped, failures);
+            return failures > 0 ? kExitBadInput : kExitOk;
+          }};
+}
+
+}  // namespace quadlod::cli

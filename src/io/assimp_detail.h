@@ -1,0 +1,18 @@
+// quadlod — the assimp halves of read_scene / write_scene (private to src/io/): scene_io.cpp
+// dispatches by extension, these do the assimp formats.
+#pragma once
+
+#include "quadlod/scene.h"
+
+namespace quadlod::io_detail {
+
+/// read_scene for every non-native extension (src/io/assimp_read.cpp).
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path);
+
+/// Serialises `scene` with assimp's exporter `format_id` ("glb2", "fbx", "collada") into `out`;
+/// false with `error` set (without the path) on failure (src/io/assimp_write.cpp).
+/// `triangulate`: fan-triangulate polygons (glTF holds triangles only).
+bool format_scene_with_assimp(const Scene& scene, const char* format_id, bool triangulate,
+                              std::string& out, std::string& error);
+
+}  // namespace quadlod::io_detail

@@ -1,0 +1,447 @@
+// quadlod — the assimp front end of read_scene (include/quadlod/scene.h).
+//
+// assimp hands over meshes whose vertices are split wherever a corner's attributes differ (and
+// FBX/glTF importers give every corner its own vertex), one aiMesh per material. quadlod's
+// reduction needs the surface's topology, so the meshes of one node are welded back together:
+//
+//   aiMesh "body/mat A" ─┐   one PolyMesh: vertices = distinct corner positions,
+//   aiMesh "body/mat B" ─┼─► per-corner UV / normal pools (deduplicated by value),
+//                        │   face_material from each aiMesh's material
+//
+// No post-process step triangulates or joins vertices (aiProcess_Triangulate /
+// JoinIdenticalVertices are not used): polygons stay polygons, and the welding here is exact
+// float equality of positions, which is what the exporter's split preserved.
+//
+// Issue 24 (skins) adds bones / weights in `per_mesh_extras` and skeleton / animations in
+// `scene_extras`; nothing else here needs to change for it.
+#include "io/assimp_detail.h"
+#include "quadlod/scene.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+namespace quadlod {
+
+namespace {
+
+/// Exact bit pattern of up to three floats: the welding and pooling key.
+struct FloatKey {
+  std::array<std::uint32_t, 3> bits{};
+  bool operator==(const FloatKey&) const = default;
+};
+struct FloatKeyHash {
+  std::size_t operator()(const FloatKey& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+FloatKey key_of(float x, float y, float z) {
+  // +0 and -0 weld together: both are the same point.
+  const auto b = [](float v) { return std::bit_cast<std::uint32_t>(v == 0.0f ? 0.0f : v); };
+  return {{b(x), b(y), b(z)}};
+}
+
+/// A pool of values deduplicated by bit pattern.
+template <class Value>
+struct Pool {
+  std::vector<Value>* values = nullptr;
+  std::unordered_map<FloatKey, Index, FloatKeyHash> index_of;
+  Index add(const FloatKey& key, const Value& value) {
+    auto [it, inserted] = index_of.try_emplace(key, static_cast<Index>(values->size()));
+    if (inserted) values->push_back(value);
+    return it->second;
+  }
+};
+
+std::string material_name(const aiMaterial& material, unsigned index) {
+  aiString name;
+  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS && name.length > 0) return name.C_Str();
+  return "material_" + std::to_string(index);
+}
+
+SceneMaterial read_material(const aiMaterial& material, unsigned index) {
+  SceneMaterial out;
+  out.name = material_name(material, index);
+  aiColor4D colour;
+  if (material.Get(AI_MATKEY_BASE_COLOR, colour) == AI_SUCCESS ||
+      material.Get(AI_MATKEY_COLOR_DIFFUSE, colour) == AI_SUCCESS)
+    out.base_color = {colour.r, colour.g, colour.b, colour.a};
+  aiString texture;
+  if (material.GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == AI_SUCCESS ||
+      material.GetTexture(aiTextureType_DIFFUSE, 0, &texture) == AI_SUCCESS)
+    out.base_color_texture = texture.C_Str();
+  return out;
+}
+
+Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d out;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out(r, c) = m[r][c];
+  return out;
+}
+
+class SceneBuilder {
+ public:
+  explicit SceneBuilder(const aiScene& ai) : ai_(ai) {}
+
+  Scene build() {
+    for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.materials.push_back(read_material(*ai_.mMaterials[i], i));
+    if (ai_.mRootNode) add_node(*ai_.mRootNode, kInvalidIndex);
+    scene_.cameras = ai_.mNumCameras;
+    scene_.lights = ai_.mNumLights;
+    scene_.animations = ai_.mNumAnimations;
+    scene_extras();
+    return std::move(scene_);
+  }
+
+ private:
+  void add_node(const aiNode& node, Index parent) {
+    const Index id = static_cast<Index>(scene_.nodes.size());
+    SceneNode out;
+    out.name = node.mName.C_Str();
+    out.parent = parent;
+    out.local = to_eigen(node.mTransformation);
+    std::vector<unsigned> group;
+    for (unsigned i = 0; i < node.mNumMeshes; ++i)
+      if (node.mMeshes[i] < ai_.mNumMeshes) group.push_back(node.mMeshes[i]);
+    const std::vector<const aiNode*> folded = per_material_children(node);
+    for (const aiNode* child : folded)
+      for (unsigned i = 0; i < child->mNumMeshes; ++i)
+        if (child->mMeshes[i] < ai_.mNumMeshes) group.push_back(child->mMeshes[i]);
+    std::sort(group.begin(), group.end());
+    group.erase(std::unique(group.begin(), group.end()), group.end());
+    scene_.nodes.push_back(std::move(out));
+    if (!group.empty()) {
+      const Index mesh = mesh_of_group(group, node);
+      if (mesh != kInvalidIndex) scene_.nodes[id].meshes.push_back(mesh);
+    }
+    for (unsigned i = 0; i < node.mNumChildren; ++i)
+      if (std::find(folded.begin(), folded.end(), node.mChildren[i]) == folded.end()) add_node(*node.mChildren[i], id);
+  }
+
+  /// assimp's FBX exporter (and so our .fbx files) moves the meshes of a node with several
+  /// materials into one child node per material, all named after the mesh, identity transform,
+  /// no children of their own:  grid_a → {grid (red), grid (blue)}. Read back as they are, the
+  /// mesh would come apart at its material borders. Such children (two or more, one shared
+  /// name, under a node without meshes) are folded back into their parent's mesh.
+  std::vector<const aiNode*> per_material_children(const aiNode& node) const {
+    std::vector<const aiNode*> children;
+    if (node.mNumMeshes > 0) return children;
+    for (unsigned i = 0; i < node.mNumChildren; ++i) {
+      const aiNode* c = node.mChildren[i];
+      if (c->mNumChildren > 0 || c->mNumMeshes == 0 || !c->mTransformation.IsIdentity()) continue;
+      bool named_after_mesh = true;
+      for (unsigned k = 0; k < c->mNumMeshes; ++k)
+        named_after_mesh = named_after_mesh && c->mMeshes[k] < ai_.mNumMeshes &&
+                           ai_.mMeshes[c->mMeshes[k]]->mName == c->mName;
+      if (named_after_mesh && (children.empty() || children[0]->mName == c->mName)) children.push_back(c);
+    }
+    if (children.size() < 2) children.clear();
+    return children;
+  }
+
+  /// The Scene mesh of a node's set of aiMeshes; the same set in another node is an instance.
+  Index mesh_of_group(const std::vector<unsigned>& group, const aiNode& node) {
+    if (auto it = mesh_of_group_.find(group); it != mesh_of_group_.end()) return it->second;
+    SceneMesh out;
+    // The aiMeshes' name when they share one (a mesh split by material), else the node's.
+    out.name = ai_.mMeshes[group[0]]->mName.C_Str();
+    for (unsigned m : group)
+      if (ai_.mMeshes[m]->mName != ai_.mMeshes[group[0]]->mName) out.name.clear();
+    if (out.name.empty()) out.name = node.mName.C_Str();
+    weld(group, out.mesh);
+    Index id = kInvalidIndex;
+    if (out.mesh.num_faces() > 0) {
+      for (unsigned m : group) per_mesh_extras(*ai_.mMeshes[m], out);
+      id = static_cast<Index>(scene_.meshes.size());
+      scene_.meshes.push_back(std::move(out));
+    }
+    mesh_of_group_.emplace(group, id);
+    return id;
+  }
+
+  /// The meshes of `group` as one PolyMesh (see the file comment).
+  void weld(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    unsigned uv_sets = 0;
+    bool normals = false, colours = false;
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      uv_sets = std::max(uv_sets, a.GetNumUVChannels());
+      normals = normals || a.HasNormals();
+      colours = colours || a.HasVertexColors(0);
+    }
+    mesh.uv_sets.resize(uv_sets);
+    std::vector<Pool<Vec2>> uv_pools(uv_sets);
+    for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
+    Pool<Vec3> normal_pool{&mesh.normals, {}};
+    std::unordered_map<FloatKey, Index, FloatKeyHash> vertex_of;
+    std::map<std::string, Index> material_of;
+    std::vector<Index> face;
+
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      for (unsigned k = 0; k < uv_sets; ++k)
+        if (mesh.uv_sets[k].name.empty() && a.HasTextureCoordsName(k))
+          mesh.uv_sets[k].name = a.mTextureCoordsNames[k]->C_Str();
+      Index material = kInvalidIndex;
+      if (a.mMaterialIndex < scene_.materials.size()) {
+        const std::string& name = scene_.materials[a.mMaterialIndex].name;
+        auto [it, inserted] = material_of.try_emplace(name, static_cast<Index>(mesh.material_names.size()));
+        if (inserted) mesh.material_names.push_back(name);
+        material = it->second;
+      }
+      // Welded vertex id of each aiMesh vertex.
+      std::vector<Index> welded(a.mNumVertices);
+      for (unsigned v = 0; v < a.mNumVertices; ++v) {
+        const aiVector3D& p = a.mVertices[v];
+        auto [it, inserted] = vertex_of.try_emplace(key_of(p.x, p.y, p.z), mesh.num_vertices());
+        if (inserted) {
+          mesh.positions.emplace_back(p.x, p.y, p.z);
+          if (colours) {
+            const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
+            mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
+          }
+        }
+        welded[v] = it->second;
+      }
+      for (unsigned f = 0; f < a.mNumFaces; ++f) {
+        const aiFace& af = a.mFaces[f];
+        // Corners (aiMesh vertex ids) with consecutive repeats removed; a face that still uses
+        // a vertex twice, or has fewer than 3 corners, is dropped (counted).
+        face.clear();
+        for (unsigned c = 0; c < af.mNumIndices; ++c) {
+          const unsigned v = af.mIndices[c];
+          if (v >= a.mNumVertices) { face.clear(); break; }
+          if (!face.empty() && welded[face.back()] == welded[v]) continue;
+          face.push_back(v);
+        }
+        while (face.size() > 1 && welded[face.front()] == welded[face.back()]) face.pop_back();
+        bool repeated = face.size() < 3;
+        for (std::size_t i = 0; i < face.size() && !repeated; ++i)
+          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = welded[face[i]] == welded[face[j]];
+        if (repeated) {
+          ++scene_.dropped_primitives;
+          continue;
+        }
+        for (unsigned v : face) {
+          mesh.corner_vertex.push_back(welded[v]);
+          for (unsigned k = 0; k < uv_sets; ++k) {
+            Index uv = kInvalidIndex;
+            if (a.HasTextureCoords(k)) {
+              const aiVector3D& t = a.mTextureCoords[k][v];
+              uv = uv_pools[k].add(key_of(t.x, t.y, 0.0f), Vec2(t.x, t.y));
+            }
+            mesh.uv_sets[k].corner.push_back(uv);
+          }
+          if (normals) {
+            Index n = kInvalidIndex;
+            if (a.HasNormals()) {
+              const aiVector3D& t = a.mNormals[v];
+              n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
+            }
+            mesh.corner_normal.push_back(n);
+          }
+        }
+        mesh.face_offsets.push_back(mesh.num_corners());
+        if (!scene_.materials.empty()) mesh.face_material.push_back(material);
+      }
+    }
+  }
+
+  /// Issue 24: bones and weights of aiMesh `a` into out.mesh.skin (its vertices are welded by
+  /// position: a bone's vertex v maps to the welded vertex of a.mVertices[v]). A welded vertex
+  /// that an earlier aiMesh of the group already weighted keeps those weights (the same vertex in
+  /// two primitives carries the same influences; adding both would count them twice).
+  void per_mesh_extras(const aiMesh& a, SceneMesh& out) {
+    if (!a.HasBones()) return;
+    PolyMesh& mesh = out.mesh;
+    std::unordered_map<FloatKey, Index, FloatKeyHash> welded_of;
+    for (Index v = 0; v < mesh.num_vertices(); ++v)
+      welded_of.emplace(key_of(float(mesh.positions[v].x()), float(mesh.positions[v].y()), float(mesh.positions[v].z())), v);
+    std::vector<std::vector<Influence>> lists(mesh.num_vertices());
+    std::vector<std::uint8_t> weighted_before(mesh.num_vertices(), 0);
+    if (!mesh.skin.empty())
+      for (Index v = 0; v < mesh.num_vertices(); ++v) {
+        lists[v] = influences_of(mesh.skin, v);
+        weighted_before[v] = !lists[v].empty();
+      }
+    for (unsigned b = 0; b < a.mNumBones; ++b) {
+      const aiBone& bone = *a.mBones[b];
+      const Index joint = joint_of(bone.mName.C_Str(), to_eigen(bone.mOffsetMatrix));
+      for (unsigned w = 0; w < bone.mNumWeights; ++w) {
+        const aiVertexWeight& vw = bone.mWeights[w];
+        if (vw.mVertexId >= a.mNumVertices || !(vw.mWeight > 0.0f)) continue;
+        const aiVector3D& p = a.mVertices[vw.mVertexId];
+        const auto it = welded_of.find(key_of(p.x, p.y, p.z));
+        if (it == welded_of.end() || weighted_before[it->second]) continue;  // a dropped corner / weighted before
+        lists[it->second].push_back({joint, vw.mWeight});
+      }
+    }
+    mesh.skin = make_skin_weights(lists);
+  }
+
+  /// The joint of a bone name, created on first use with the bone's offset matrix as B⁻¹.
+  Index joint_of(const std::string& name, const Eigen::Matrix4d& inverse_bind) {
+    auto [it, inserted] = joint_index_.try_emplace(name, static_cast<Index>(scene_.rig.skeleton.joints.size()));
+    if (inserted) {
+      Joint j;
+      j.name = name;
+      j.inverse_bind = inverse_bind;
+      scene_.rig.skeleton.joints.push_back(j);
+    }
+    return it->second;
+  }
+
+  static Eigen::Matrix4d world_of(const aiNode* node) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    for (const aiNode* n = node; n; n = n->mParent) m = to_eigen(n->mTransformation) * m;
+    return m;
+  }
+
+  /// Issue 24: the skeleton from the nodes the bones name, and ai_.mAnimations on them.
+  void scene_extras() {
+    Skeleton& sk = scene_.rig.skeleton;
+    if (sk.joints.empty() || !ai_.mRootNode) return;
+    auto is_joint_below = [&](const aiNode* n) {  // some ancestor of n (n included) is a joint
+      for (; n; n = n->mParent)
+        if (joint_index_.count(n->mName.C_Str())) return true;
+      return false;
+    };
+    bool root_set = false;
+    // Joints grow while this runs: a non-joint node between two joints becomes a joint (no
+    // weights, identity B⁻¹) so that its transform stays in the chain.
+    for (Index j = 0; j < sk.joints.size(); ++j) {
+      const aiNode* node = ai_.mRootNode->FindNode(sk.joints[j].name.c_str());
+      if (!node) continue;  // a bone without a node: a root at the origin
+      aiVector3D scaling, position;
+      aiQuaternion rotation;
+      node->mTransformation.Decompose(scaling, rotation, position);
+      sk.joints[j].rest.translation = Vec3(position.x, position.y, position.z);
+      sk.joints[j].rest.rotation = Quat(rotation.w, rotation.x, rotation.y, rotation.z).normalized();
+      sk.joints[j].rest.scale = Vec3(scaling.x, scaling.y, scaling.z);
+      const aiNode* p = node->mParent;
+      if (p && is_joint_below(p)) {
+        sk.joints[j].parent = joint_of(p->mName.C_Str(), Eigen::Matrix4d::Identity());
+      } else if (!root_set) {
+        sk.root_transform = p ? world_of(p) : Eigen::Matrix4d::Identity();
+        root_set = true;
+      }
+    }
+    for (unsigned a = 0; a < ai_.mNumAnimations; ++a) {
+      const aiAnimation& in = *ai_.mAnimations[a];
+      const double ticks = in.mTicksPerSecond > 0.0 ? in.mTicksPerSecond : 25.0;
+      Animation anim;
+      anim.name = in.mName.length ? in.mName.C_Str() : "animation" + std::to_string(a);
+      for (unsigned c = 0; c < in.mNumChannels; ++c) {
+        const aiNodeAnim& ch = *in.mChannels[c];
+        const auto it = joint_index_.find(ch.mNodeName.C_Str());
+        if (it == joint_index_.end()) continue;
+        AnimationChannel t, r, s;
+        t.joint = r.joint = s.joint = it->second;
+        t.path = AnimationChannel::Path::Translation;
+        r.path = AnimationChannel::Path::Rotation;
+        s.path = AnimationChannel::Path::Scale;
+        for (unsigned k = 0; k < ch.mNumPositionKeys; ++k) {
+          t.times.push_back(ch.mPositionKeys[k].mTime / ticks);
+          const aiVector3D& v = ch.mPositionKeys[k].mValue;
+          t.values.emplace_back(v.x, v.y, v.z, 0.0);
+        }
+        for (unsigned k = 0; k < ch.mNumRotationKeys; ++k) {
+          r.times.push_back(ch.mRotationKeys[k].mTime / ticks);
+          const aiQuaternion& q = ch.mRotationKeys[k].mValue;
+          r.values.emplace_back(q.x, q.y, q.z, q.w);
+        }
+        for (unsigned k = 0; k < ch.mNumScalingKeys; ++k) {
+          s.times.push_back(ch.mScalingKeys[k].mTime / ticks);
+          const aiVector3D& v = ch.mScalingKeys[k].mValue;
+          s.values.emplace_back(v.x, v.y, v.z, 0.0);
+        }
+        for (AnimationChannel* x : {&t, &r, &s})
+          if (!x->times.empty() && std::is_sorted(x->times.begin(), x->times.end())) anim.channels.push_back(std::move(*x));
+      }
+      if (!anim.channels.empty()) scene_.rig.animations.push_back(std::move(anim));
+    }
+  }
+
+  const aiScene& ai_;
+  Scene scene_;
+  std::map<std::vector<unsigned>, Index> mesh_of_group_;
+  std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
+};
+
+/// The post-processing steps: checks, and points / lines removed — nothing that triangulates,
+/// joins vertices or reorders faces.
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
+
+void configure(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // FBX pivots as separate "$AssimpFbx$" helper nodes would change the hierarchy on a round trip.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+}
+
+SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name) {
+  SceneReadResult result;
+  if (!ai) {
+    std::string message = importer.GetErrorString();
+    if (message.empty()) message = "unreadable scene";
+    result.error = name + ": assimp: " + message;
+    return result;
+  }
+  result.scene = SceneBuilder(*ai).build();
+  return result;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+namespace io_detail {
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path) {
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    SceneReadResult result;
+    result.error = "cannot read " + path.string() + ": " +
+                   (std::filesystem::exists(path, ec) ? "not a regular file" : "No such file or directory");
+    return result;
+  }
+  Assimp::Importer importer;
+  configure(importer);
+  const aiScene* ai = importer.ReadFile(path.string(), kImportSteps);
+  SceneReadResult result = finish(ai, importer, path.string());
+  result.seconds = seconds_since(start);
+  return result;
+}
+}  // namespace io_detail
+
+SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::string_view hint,
+                                       const std::string& name) {
+  const auto start = std::chrono::steady_clock::now();
+  Assimp::Importer importer;
+  configure(importer);
+  const std::string hint_text(hint);
+  const aiScene* ai = size == 0 ? nullptr : importer.ReadFileFromMemory(data, size, kImportSteps, hint_text.c_str());
+  SceneReadResult result;
+  if (size == 0)
+    result.error = name + ": empty buffer";
+  else
+    result = finish(ai, importer, name);
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace quadlod

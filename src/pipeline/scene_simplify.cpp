@@ -1,0 +1,80 @@
+// quadlod — simplify_scene (include/quadlod/lod.h): every mesh of a scene reduced on its own,
+// the scene's target split among the meshes by their triangle-equivalents. Meshes are stored
+// once however many nodes reference them, so instances are reduced once.
+#include "quadlod/lod.h"
+#include "quadlod/metrics.h"
+
+#include <chrono>
+#include <cmath>
+
+namespace quadlod {
+
+SceneSimplifyResult simplify_scene(const Scene& input, const SceneSimplifyParams& params) {
+  SceneSimplifyResult result;
+  if (input.meshes.empty()) {
+    result.error = "the scene has no mesh to reduce";
+    return result;
+  }
+  result.scene = input;
+  result.input_tri_equivalent = input.tri_equivalent_count();
+  const SimplifyOptions& base = params.options;
+  const bool absolute = base.target_tri_equivalent > 0;
+  result.report = {{"per_mesh", params.per_mesh}, {"meshes", nlohmann::json::array()}};
+  for (std::size_t m = 0; m < input.meshes.size(); ++m) {
+    const SceneMesh& mesh = input.meshes[m];
+    const std::uint64_t te = tri_equivalent_count(mesh.mesh);
+    SimplifyOptions options = base;
+    if (absolute && !params.per_mesh) {
+      // The scene's target N split by size: mesh i gets N · te_i / Σ te (at least 1).
+      const double share = result.input_tri_equivalent > 0 ? double(te) / double(result.input_tri_equivalent) : 0.0;
+      options.target_tri_equivalent = std::max<std::uint64_t>(1, std::llround(share * double(base.target_tri_equivalent)));
+    }
+    const std::uint64_t target =
+        options.target_tri_equivalent > 0 ? options.target_tri_equivalent
+                                           : std::max<std::uint64_t>(1, std::llround(options.ratio * double(te)));
+    const auto start = std::chrono::steady_clock::now();
+    SimplifyResult reduced;
+    if (te <= target) {
+      // Already small enough (e.g. --faces per mesh above a small mesh's size): unchanged.
+      reduced.mesh = mesh.mesh;
+      reduced.achieved = te;
+      const FaceCounts counts = count_faces(mesh.mesh);
+      reduced.quads = static_cast<Index>(counts.quads);
+      reduced.triangles = static_cast<Index>(counts.tris);
+      reduced.ngons = static_cast<Index>(counts.ngons);
+      reduced.note = "already at or below the target";
+    } else {
+      reduced = simplify(mesh.mesh, options);
+      if (!reduced.ok()) {
+        result.error = "mesh '" + mesh.name + "': " + reduced.error;
+        return result;
+      }
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.target += target;
+    result.achieved += reduced.achieved;
+    result.quads += reduced.quads;
+    result.triangles += reduced.triangles;
+    result.ngons += reduced.ngons;
+    result.report["meshes"].push_back({{"name", mesh.name},
+                                       {"input_tri_equivalent", te},
+                                       {"target", target},
+                                       {"achieved", reduced.achieved},
+                                       {"quads", reduced.quads},
+                                       {"triangles", reduced.triangles},
+                                       {"ngons", reduced.ngons},
+                                       {"seconds", seconds},
+                                       {"note", reduced.note},
+                                       {"simplify", std::move(reduced.report)}});
+    result.scene.meshes[m].mesh = std::move(reduced.mesh);
+  }
+  result.report["input_tri_equivalent"] = result.input_tri_equivalent;
+  result.report["target"] = result.target;
+  result.report["achieved"] = result.achieved;
+  result.report["quads"] = result.quads;
+  result.report["triangles"] = result.triangles;
+  result.report["ngons"] = result.ngons;
+  return result;
+}
+
+}  // namespace quadlod
