@@ -317,3 +317,46 @@ TEST(SceneFbx, BlenderImportsOurFbxWithItsQuads) {
   for (const char* node : {"grid_a", "grid_b", "torus_c"}) EXPECT_NE(names.find(node), std::string::npos) << names;
   fs::remove_all(dir);
 }
+
+// --- welding ------------------------------------------------------------------------------------
+
+namespace {
+
+/// Two quads sharing an edge; face 0's corners have normal +Z, face 1's +Z tilted by `degrees`
+/// about Y. Written as Collada and read back: the corner normals of the shared vertices.
+std::pair<Index, Index> shared_vertex_normals(double degrees, const SceneReadOptions& options) {
+  PolyMesh mesh = make_grid(2, 1);
+  const double a = degrees * 3.14159265358979323846 / 180.0;
+  mesh.normals = {Vec3(0, 0, 1), Vec3(std::sin(a), 0, std::cos(a))};
+  mesh.corner_normal.resize(mesh.num_corners());
+  for (Index f = 0; f < 2; ++f)
+    for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) mesh.corner_normal[c] = f;
+  const fs::path dir = scratch_dir("scene-normal-weld");
+  EXPECT_TRUE(write_scene(scene_from_mesh(mesh, "two"), dir / "two.dae").ok());
+  const SceneReadResult r = read_scene(dir / "two.dae", options);
+  fs::remove_all(dir);
+  EXPECT_TRUE(r.ok()) << r.error;
+  if (!r.ok() || r.scene.meshes.size() != 1) return {kInvalidIndex, kInvalidIndex};
+  const PolyMesh& back = r.scene.meshes[0].mesh;
+  EXPECT_EQ(back.num_vertices(), 6u);
+  // Vertex 1 of the grid, (0.5, 0, 0), is in both faces: its corner in each.
+  Index in_face[2] = {kInvalidIndex, kInvalidIndex};
+  for (Index f = 0; f < back.num_faces(); ++f)
+    for (Index c = back.face_begin(f); c < back.face_end(f); ++c)
+      if (back.positions[back.corner_vertex[c]].isApprox(Vec3(0.5, 0, 0))) in_face[f] = back.corner_normal[c];
+  return {in_face[0], in_face[1]};
+}
+
+}  // namespace
+
+TEST(SceneWeld, NormalsWithinTheWeldAngleShareAnEntry) {
+  const auto [a, b] = shared_vertex_normals(0.01, {});
+  EXPECT_NE(a, kInvalidIndex);
+  EXPECT_EQ(a, b);  // 0.01° < 0.1°: one normal, no seam
+  const auto [c, d] = shared_vertex_normals(5.0, {});
+  EXPECT_NE(c, d);  // a crease stays
+  SceneReadOptions exact;
+  exact.normal_weld_degrees = 0.0;
+  const auto [e, f] = shared_vertex_normals(0.01, exact);
+  EXPECT_NE(e, f);
+}

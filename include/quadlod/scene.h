@@ -68,6 +68,17 @@ struct Scene {
   Eigen::Matrix4d world_transform(Index node) const;
 };
 
+struct SceneReadOptions {
+  /// For the native readers (.obj / .ply / .off).
+  ReadOptions native;
+  /// The assimp reader gives two corners of one welded vertex the same normal when their
+  /// normals are within this angle (degrees). Exporters store normals with rounding (Blender's
+  /// FBX: 0.01° between the corners of one smooth vertex), and normals that differ by value are a
+  /// normal seam to the reduction (src/mesh/features.h), so without this every edge of a smooth
+  /// mesh read from FBX would be one. Real creases are degrees apart. 0 = exact equality only.
+  double normal_weld_degrees = 0.1;
+};
+
 struct SceneReadResult {
   Scene scene;
   std::string error;     ///< empty on success: one line naming the file
@@ -95,8 +106,10 @@ bool scene_readable_path(const std::filesystem::path& path);
 ///   * runs no triangulation and no vertex joining of its own: the meshes of one node (assimp
 ///     splits a mesh by material) become one PolyMesh, whose vertices are the distinct corner
 ///     positions (exact float equality) — the topology the exporter split at UV / normal / material
-///     seams comes back — and whose UV sets (all of them, named when the file names them),
-///     normals and first colour set are pools with one index per corner (deduplicated by value);
+///     seams comes back; a face whose vertices would all be those of an earlier face (surfaces
+///     lying on top of each other) gets vertices of its own instead — and whose UV sets (all of them, named when the file names them),
+///     normals and first colour set are pools with one index per corner (deduplicated by value;
+///     the normals of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
 ///   * drops points, lines and faces with fewer than 3 distinct corners (counted in
 ///     dropped_primitives);
 ///   * keeps the node hierarchy with local transforms (FBX pivot helpers folded), materials with
@@ -104,12 +117,12 @@ bool scene_readable_path(const std::filesystem::path& path);
 ///     share one Scene mesh (an instance).
 /// A file assimp cannot read is an error naming the file and assimp's message. A scene with no
 /// meshes (empty, or a camera only) is NOT an error here: callers that need geometry check.
-SceneReadResult read_scene(const std::filesystem::path& path, const ReadOptions& options = {});
+SceneReadResult read_scene(const std::filesystem::path& path, const SceneReadOptions& options = {});
 
 /// The same from memory (assimp formats only; for fuzzing and tests): `hint` is the extension
 /// without the dot ("glb", "fbx", "dae"); `name` names the data in error messages.
 SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::string_view hint,
-                                       const std::string& name = "<memory>");
+                                       const std::string& name = "<memory>", const SceneReadOptions& options = {});
 
 /// A one-mesh scene around a mesh (one root node named `name`).
 Scene scene_from_mesh(PolyMesh mesh, const std::string& name);

@@ -7,7 +7,7 @@
 namespace quadlod::io_detail {
 
 /// read_scene for every non-native extension (src/io/assimp_read.cpp).
-SceneReadResult read_scene_with_assimp(const std::filesystem::path& path);
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const SceneReadOptions& options);
 
 /// Serialises `scene` with assimp's exporter `format_id` ("glb2", "fbx", "collada") into `out`;
 /// false with `error` set (without the path) on failure (src/io/assimp_write.cpp).

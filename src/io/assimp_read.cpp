@@ -27,9 +27,11 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace quadlod {
 
@@ -52,6 +54,14 @@ FloatKey key_of(float x, float y, float z) {
   const auto b = [](float v) { return std::bit_cast<std::uint32_t>(v == 0.0f ? 0.0f : v); };
   return {{b(x), b(y), b(z)}};
 }
+
+struct IndexListHash {
+  std::size_t operator()(const std::vector<Index>& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (Index v : k) h = (h ^ v) * 1099511628211ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
 
 /// A pool of values deduplicated by bit pattern.
 template <class Value>
@@ -94,7 +104,8 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
 
 class SceneBuilder {
  public:
-  explicit SceneBuilder(const aiScene& ai) : ai_(ai) {}
+  SceneBuilder(const aiScene& ai, const SceneReadOptions& options)
+      : ai_(ai), normal_weld_cos_(std::cos(options.normal_weld_degrees * 3.14159265358979323846 / 180.0)) {}
 
   Scene build() {
     for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.materials.push_back(read_material(*ai_.mMaterials[i], i));
@@ -174,6 +185,7 @@ class SceneBuilder {
 
   /// The meshes of `group` as one PolyMesh (see the file comment).
   void weld(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    welded_of_.clear();  // issue 24: the map per_mesh_extras reads, for this group only
     unsigned uv_sets = 0;
     bool normals = false, colours = false;
     for (unsigned m : group) {
@@ -186,9 +198,14 @@ class SceneBuilder {
     std::vector<Pool<Vec2>> uv_pools(uv_sets);
     for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
     Pool<Vec3> normal_pool{&mesh.normals, {}};
-    std::unordered_map<FloatKey, Index, FloatKeyHash> vertex_of;
+    // Distinct positions, and per position the welded vertices standing on it ("layers"; more
+    // than one only where surfaces lie on top of each other, see place_face).
+    std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
+    std::vector<std::vector<Index>> layers;
+    std::unordered_set<std::vector<Index>, IndexListHash> faces_seen;
+    std::vector<std::vector<Index>> normals_at;  // per welded vertex: the normal entries its corners use
     std::map<std::string, Index> material_of;
-    std::vector<Index> face;
+    std::vector<Index> face, chosen, key;
 
     for (unsigned m : group) {
       const aiMesh& a = *ai_.mMeshes[m];
@@ -202,41 +219,74 @@ class SceneBuilder {
         if (inserted) mesh.material_names.push_back(name);
         material = it->second;
       }
-      // Welded vertex id of each aiMesh vertex.
-      std::vector<Index> welded(a.mNumVertices);
+      // Position id of each aiMesh vertex.
+      std::vector<Index> position(a.mNumVertices);
       for (unsigned v = 0; v < a.mNumVertices; ++v) {
         const aiVector3D& p = a.mVertices[v];
-        auto [it, inserted] = vertex_of.try_emplace(key_of(p.x, p.y, p.z), mesh.num_vertices());
-        if (inserted) {
-          mesh.positions.emplace_back(p.x, p.y, p.z);
-          if (colours) {
-            const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
-            mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
-          }
-        }
-        welded[v] = it->second;
+        auto [it, inserted] = position_of.try_emplace(key_of(p.x, p.y, p.z), static_cast<Index>(layers.size()));
+        if (inserted) layers.emplace_back();
+        position[v] = it->second;
       }
       for (unsigned f = 0; f < a.mNumFaces; ++f) {
         const aiFace& af = a.mFaces[f];
         // Corners (aiMesh vertex ids) with consecutive repeats removed; a face that still uses
-        // a vertex twice, or has fewer than 3 corners, is dropped (counted).
+        // a position twice, or has fewer than 3 corners, is dropped (counted).
         face.clear();
         for (unsigned c = 0; c < af.mNumIndices; ++c) {
           const unsigned v = af.mIndices[c];
           if (v >= a.mNumVertices) { face.clear(); break; }
-          if (!face.empty() && welded[face.back()] == welded[v]) continue;
+          if (!face.empty() && position[face.back()] == position[v]) continue;
           face.push_back(v);
         }
-        while (face.size() > 1 && welded[face.front()] == welded[face.back()]) face.pop_back();
+        while (face.size() > 1 && position[face.front()] == position[face.back()]) face.pop_back();
         bool repeated = face.size() < 3;
         for (std::size_t i = 0; i < face.size() && !repeated; ++i)
-          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = welded[face[i]] == welded[face[j]];
+          for (std::size_t j = i + 1; j < face.size() && !repeated; ++j) repeated = position[face[i]] == position[face[j]];
         if (repeated) {
           ++scene_.dropped_primitives;
           continue;
         }
+        // Welding by position alone would make two faces lying exactly on top of each other (hair
+        // cards, doubled shells: separate vertices in the source) one face used twice. A face
+        // whose welded vertices are those of an earlier face goes one layer up instead, onto
+        // vertices of its own, and the faces after it that repeat faces of the lower layer
+        // follow it there — so a doubled surface comes back as two connected surfaces.
+        std::size_t layer = 0;
+        for (;; ++layer) {
+          key.clear();
+          for (unsigned v : face) {
+            if (layers[position[v]].size() <= layer) break;
+            key.push_back(layers[position[v]][layer]);
+          }
+          if (key.size() < face.size()) break;
+          std::sort(key.begin(), key.end());
+          if (!faces_seen.count(key)) break;
+        }
+        chosen.clear();
         for (unsigned v : face) {
-          mesh.corner_vertex.push_back(welded[v]);
+          std::vector<Index>& here = layers[position[v]];
+          if (here.size() > layer) {
+            chosen.push_back(here[layer]);
+            continue;
+          }
+          const aiVector3D& p = a.mVertices[v];
+          here.push_back(mesh.add_vertex(Vec3(p.x, p.y, p.z)));
+          normals_at.emplace_back();
+          if (colours) {
+            const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
+            mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
+          }
+          chosen.push_back(here.back());
+        }
+        key = chosen;
+        std::sort(key.begin(), key.end());
+        faces_seen.insert(key);
+        std::vector<Index>& welded_of = welded_of_[&a];  // issue 24: for the bone weights
+        if (welded_of.empty()) welded_of.assign(a.mNumVertices, kInvalidIndex);
+        for (std::size_t i = 0; i < face.size(); ++i) {
+          const unsigned v = face[i];
+          mesh.corner_vertex.push_back(chosen[i]);
+          if (welded_of[v] == kInvalidIndex) welded_of[v] = chosen[i];
           for (unsigned k = 0; k < uv_sets; ++k) {
             Index uv = kInvalidIndex;
             if (a.HasTextureCoords(k)) {
@@ -250,6 +300,7 @@ class SceneBuilder {
             if (a.HasNormals()) {
               const aiVector3D& t = a.mNormals[v];
               n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
+              n = weld_normal(mesh.normals, normals_at[chosen[i]], n);
             }
             mesh.corner_normal.push_back(n);
           }
@@ -260,16 +311,28 @@ class SceneBuilder {
     }
   }
 
-  /// Issue 24: bones and weights of aiMesh `a` into out.mesh.skin (its vertices are welded by
-  /// position: a bone's vertex v maps to the welded vertex of a.mVertices[v]). A welded vertex
+  /// The normal entry a corner of a vertex uses: an entry another corner of that vertex already
+  /// uses when it lies within the weld angle (SceneReadOptions::normal_weld_degrees), else `n`.
+  Index weld_normal(const std::vector<Vec3>& pool, std::vector<Index>& at_vertex, Index n) const {
+    for (Index used : at_vertex) {
+      if (used == n) return n;
+      const double lengths = pool[used].norm() * pool[n].norm();
+      if (lengths > 0 && pool[used].dot(pool[n]) >= normal_weld_cos_ * lengths) return used;
+    }
+    at_vertex.push_back(n);
+    return n;
+  }
+
+  /// Issue 24: bones and weights of aiMesh `a` into out.mesh.skin (an aiMesh vertex maps to the
+  /// welded vertex its first face corner took in weld(), recorded in welded_of_). A welded vertex
   /// that an earlier aiMesh of the group already weighted keeps those weights (the same vertex in
   /// two primitives carries the same influences; adding both would count them twice).
   void per_mesh_extras(const aiMesh& a, SceneMesh& out) {
     if (!a.HasBones()) return;
     PolyMesh& mesh = out.mesh;
-    std::unordered_map<FloatKey, Index, FloatKeyHash> welded_of;
-    for (Index v = 0; v < mesh.num_vertices(); ++v)
-      welded_of.emplace(key_of(float(mesh.positions[v].x()), float(mesh.positions[v].y()), float(mesh.positions[v].z())), v);
+    const auto recorded = welded_of_.find(&a);
+    if (recorded == welded_of_.end()) return;  // no face of `a` survived the weld
+    const std::vector<Index>& welded_of = recorded->second;
     std::vector<std::vector<Influence>> lists(mesh.num_vertices());
     std::vector<std::uint8_t> weighted_before(mesh.num_vertices(), 0);
     if (!mesh.skin.empty())
@@ -283,10 +346,9 @@ class SceneBuilder {
       for (unsigned w = 0; w < bone.mNumWeights; ++w) {
         const aiVertexWeight& vw = bone.mWeights[w];
         if (vw.mVertexId >= a.mNumVertices || !(vw.mWeight > 0.0f)) continue;
-        const aiVector3D& p = a.mVertices[vw.mVertexId];
-        const auto it = welded_of.find(key_of(p.x, p.y, p.z));
-        if (it == welded_of.end() || weighted_before[it->second]) continue;  // a dropped corner / weighted before
-        lists[it->second].push_back({joint, vw.mWeight});
+        const Index welded = welded_of[vw.mVertexId];
+        if (welded == kInvalidIndex || weighted_before[welded]) continue;  // used by no face / weighted before
+        lists[welded].push_back({joint, vw.mWeight});
       }
     }
     mesh.skin = make_skin_weights(lists);
@@ -376,9 +438,11 @@ class SceneBuilder {
   }
 
   const aiScene& ai_;
+  const double normal_weld_cos_;
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
   std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
+  std::map<const aiMesh*, std::vector<Index>> welded_of_;  // issue 24: aiMesh vertex → welded vertex
 };
 
 /// The post-processing steps: checks, and points / lines removed — nothing that triangulates,
@@ -391,7 +455,8 @@ void configure(Assimp::Importer& importer) {
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
 }
 
-SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name) {
+SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
+                       const SceneReadOptions& options) {
   SceneReadResult result;
   if (!ai) {
     std::string message = importer.GetErrorString();
@@ -399,7 +464,7 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
     result.error = name + ": assimp: " + message;
     return result;
   }
-  result.scene = SceneBuilder(*ai).build();
+  result.scene = SceneBuilder(*ai, options).build();
   return result;
 }
 
@@ -410,7 +475,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 namespace io_detail {
-SceneReadResult read_scene_with_assimp(const std::filesystem::path& path) {
+SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const SceneReadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -422,14 +487,14 @@ SceneReadResult read_scene_with_assimp(const std::filesystem::path& path) {
   Assimp::Importer importer;
   configure(importer);
   const aiScene* ai = importer.ReadFile(path.string(), kImportSteps);
-  SceneReadResult result = finish(ai, importer, path.string());
+  SceneReadResult result = finish(ai, importer, path.string(), options);
   result.seconds = seconds_since(start);
   return result;
 }
 }  // namespace io_detail
 
 SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::string_view hint,
-                                       const std::string& name) {
+                                       const std::string& name, const SceneReadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Assimp::Importer importer;
   configure(importer);
@@ -439,7 +504,7 @@ SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::
   if (size == 0)
     result.error = name + ": empty buffer";
   else
-    result = finish(ai, importer, name);
+    result = finish(ai, importer, name, options);
   result.seconds = seconds_since(start);
   return result;
 }

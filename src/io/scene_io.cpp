@@ -90,9 +90,9 @@ Scene scene_from_mesh(PolyMesh mesh, const std::string& name) {
   return scene;
 }
 
-SceneReadResult read_scene(const std::filesystem::path& path, const ReadOptions& options) {
-  if (!is_native(path)) return io_detail::read_scene_with_assimp(path);
-  ReadResult in = read_mesh(path, options);
+SceneReadResult read_scene(const std::filesystem::path& path, const SceneReadOptions& options) {
+  if (!is_native(path)) return io_detail::read_scene_with_assimp(path, options);
+  ReadResult in = read_mesh(path, options.native);
   SceneReadResult result;
   result.seconds = in.seconds;
   if (!in.ok()) {
