@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 
 namespace quadlod {
 namespace {
@@ -257,6 +258,106 @@ TEST_F(SkinIo, AssimpSceneReaderReadsTheSkinAndRig) {
     ASSERT_NEAR((expected[u] - got[v]).norm(), 0.0, 1e-4) << "vertex " << v;
   }
 }
+
+}  // namespace
+}  // namespace quadlod
+
+namespace quadlod {
+namespace {
+
+// FBX clusters through assimp: Blender turns quadlod's skinned glb into an FBX (armature, skin
+// clusters, baked action); read_scene must give weights, a skeleton and the animation such that
+// the first frame is the bind pose (the tube is not bent there) and the last frame bends the top.
+TEST_F(SkinIo, FbxClustersFromBlenderReadThroughAssimp) {
+  if (std::system("command -v blender >/dev/null 2>&1") != 0) GTEST_SKIP() << "blender not installed";
+  const SkinnedMesh tube = make_bending_tube(12, 16, 2);
+  const fs::path glb = dir / "tube.glb", fbx = dir / "tube.fbx", script = dir / "to_fbx.py", log = dir / "blender.log";
+  ASSERT_TRUE(write_skinned_glb(tube.mesh, tube.rig, glb).ok());
+  testing::write_text(script, R"PY(
+import sys, numpy
+if not hasattr(numpy, "bool"):
+    numpy.bool = numpy.bool_
+import bpy
+src, dst = sys.argv[sys.argv.index("--") + 1:]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.import_scene.gltf(filepath=src)
+bpy.ops.export_scene.fbx(filepath=dst, add_leaf_bones=False, bake_anim=True, bake_anim_use_all_actions=True)
+)PY");
+  const std::string cmd = "blender -b --factory-startup --python-exit-code 1 --python '" + script.string() + "' -- '" +
+                          glb.string() + "' '" + fbx.string() + "' > '" + log.string() + "' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << testing::slurp(log);
+  const SceneReadResult r = read_scene(fbx);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const PolyMesh* mesh = nullptr;
+  for (const SceneMesh& m : r.scene.meshes)
+    if (!m.mesh.skin.empty()) mesh = &m.mesh;
+  ASSERT_NE(mesh, nullptr);
+  ASSERT_EQ(mesh->check_layout(), "");
+  EXPECT_EQ(mesh->num_vertices(), tube.mesh.num_vertices());
+  EXPECT_LE(mesh->skin.max_influences(), 2u);
+  const Rig& rig = r.scene.rig;
+  ASSERT_EQ(rig.skeleton.check(), "");
+  ASSERT_GE(rig.skeleton.num_joints(), 2u);
+  ASSERT_GE(rig.animations.size(), 1u);
+  const auto frames = rig.animations[0].frame_times();
+  ASSERT_GE(frames.size(), 2u);
+  const double size = bounding_box(*mesh).diagonal();
+  const auto first = posed_positions(*mesh, rig, frames.front()), last = posed_positions(*mesh, rig, frames.back());
+  // glTF and FBX frames may differ by the exporter's axis / unit conventions: compare shapes, not
+  // coordinates — the first frame poses the mesh as it lies (unbent), the last moves the top.
+  double at_first = 0.0, at_last = 0.0;
+  for (Index v = 0; v < mesh->num_vertices(); ++v) {
+    at_first = std::max(at_first, (first[v] - mesh->positions[v]).norm());
+    at_last = std::max(at_last, (last[v] - mesh->positions[v]).norm());
+  }
+  EXPECT_LT(at_first, 1e-3 * size);
+  EXPECT_GT(at_last, 0.2 * size);
+}
+
+}  // namespace
+}  // namespace quadlod
+
+namespace quadlod {
+namespace {
+
+#ifdef QUADLOD_CORPUS_DIR
+// The assimp scene reader and the project's glTF reader pose the ram alike at every 20th frame.
+TEST(SkinCorpus, RamThroughAssimpPosesAsTheGltfReader) {
+  const fs::path glb = fs::path(QUADLOD_CORPUS_DIR) / "animated" / "yofrankie_ram_walk.glb";
+  if (!fs::exists(glb)) GTEST_SKIP() << "corpus not present";
+  const SkinnedReadResult own = read_skinned_gltf(glb);
+  ASSERT_TRUE(own.ok()) << own.error;
+  const SceneReadResult scene = read_scene(glb);
+  ASSERT_TRUE(scene.ok()) << scene.error;
+  const PolyMesh* mesh = nullptr;
+  for (const SceneMesh& m : scene.scene.meshes)
+    if (!m.mesh.skin.empty()) mesh = &m.mesh;
+  ASSERT_NE(mesh, nullptr);
+  ASSERT_EQ(mesh->check_layout(), "");
+  const Rig& rig = scene.scene.rig;
+  ASSERT_EQ(rig.skeleton.check(), "");
+  ASSERT_EQ(rig.animations.size(), 1u);
+  std::map<std::array<double, 3>, Index> own_vertex;
+  for (Index v = 0; v < own.skinned.mesh.num_vertices(); ++v) {
+    const Vec3& p = own.skinned.mesh.positions[v];
+    own_vertex[{p.x(), p.y(), p.z()}] = v;
+  }
+  const auto frames = own.skinned.rig.animations[0].frame_times();
+  const double size = bounding_box(own.skinned.mesh).diagonal();
+  for (std::size_t f = 0; f < frames.size(); f += 20) {
+    const auto a = posed_positions(own.skinned.mesh, own.skinned.rig, frames[f]);
+    const auto b = posed_positions(*mesh, rig, frames[f]);
+    double worst = 0.0;
+    for (Index v = 0; v < mesh->num_vertices(); ++v) {
+      const Vec3& p = mesh->positions[v];
+      const auto it = own_vertex.find({p.x(), p.y(), p.z()});
+      ASSERT_NE(it, own_vertex.end()) << "vertex " << v;
+      worst = std::max(worst, (a[it->second] - b[v]).norm());
+    }
+    EXPECT_LT(worst, 1e-5 * size) << "frame " << f;
+  }
+}
+#endif
 
 }  // namespace
 }  // namespace quadlod

@@ -24,6 +24,7 @@ struct SimplifyCliOptions {
   bool no_features = false, no_greedy_fallback = false;
   bool per_mesh = false;
   std::string rig, glb;  // issue 24: skinned input / skinned .glb output
+  std::string skin_border_bones = "any";
 };
 
 }  // namespace
@@ -129,6 +130,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                   "Keep edges whose endpoints' weights differ by more than this and follow unrelated bones (> 1 = off)")
       ->check(CLI::Range(0.0, 2.0))
       ->capture_default_str();
+  sub->add_option("--skin-border-bones", opt->skin_border_bones,
+                  "Which bones --skin-border separates: any two, or unrelated ones only (parent and child may merge)")
+      ->check(CLI::IsMember({"any", "unrelated"}))
+      ->capture_default_str();
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
   return {sub, [opt, ratio, faces, &global]() -> int {
             if (ratio->count() == 0 && faces->count() == 0) {
@@ -182,7 +187,8 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
               if (!plain.ok()) return fail(plain.error);
               in.mesh = std::move(plain.mesh);
             }
-            for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
+            if (opt->skin_border_bones == "unrelated")
+              for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             const double read_seconds = clock.seconds();
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);

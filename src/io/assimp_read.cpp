@@ -366,6 +366,12 @@ class SceneBuilder {
     return it->second;
   }
 
+  bool source_is_gltf() const {
+    aiString format;
+    return ai_.mMetaData && ai_.mMetaData->Get("SourceAsset_Format", format) &&
+           std::string(format.C_Str()).find("glTF") != std::string::npos;
+  }
+
   static Eigen::Matrix4d world_of(const aiNode* node) {
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     for (const aiNode* n = node; n; n = n->mParent) m = to_eigen(n->mTransformation) * m;
@@ -399,6 +405,21 @@ class SceneBuilder {
       } else if (!root_set) {
         sk.root_transform = p ? world_of(p) : Eigen::Matrix4d::Identity();
         root_set = true;
+      }
+    }
+    // Bind space. glTF binds in the skinned mesh's own space and ignores its node's transform
+    // (glTF 2.0 §3.7.3.3): the inverse bind matrices already map it. assimp's other importers
+    // (FBX clusters, Collada) give offset matrices from mesh space to bone space with the mesh
+    // node's world transform W applied by the skinning, so G·B⁻¹·v lands in world space; W⁻¹ in
+    // front of the roots brings the pose back to the mesh's space, and the bind pose gives the
+    // unposed mesh in both cases (skin.h's convention).
+    if (!source_is_gltf()) {
+      for (Index n = 0; n < scene_.nodes.size(); ++n) {
+        bool skinned = false;
+        for (Index m : scene_.nodes[n].meshes) skinned |= !scene_.meshes[m].mesh.skin.empty();
+        if (!skinned) continue;
+        sk.root_transform = scene_.world_transform(n).inverse() * sk.root_transform;
+        break;
       }
     }
     for (unsigned a = 0; a < ai_.mNumAnimations; ++a) {
