@@ -241,8 +241,8 @@ TEST(SkinThroughReduction, TubeWeightsStayWithinTheInputRange) {
 }
 
 TEST(SkinBorders, UnrelatedBonesOnly) {
-  // Rigid weights (blend → 0): the ring of edges across z = 1 changes every weight.
-  const SkinnedMesh tube = make_bending_tube(8, 8, 2, 0.25, 2.0, 1e-6);
+  // Rigid weights (blend 0): the ring of edges across z = 1 changes every weight.
+  const SkinnedMesh tube = make_bending_tube(8, 8, 2, 0.25, 2.0, 0.0);
   const Connectivity conn = build_connectivity(tube.mesh);
   SkinBorderParams p;
   const SkinBorders unrelated = find_skin_borders(tube.mesh, conn, p);

@@ -131,7 +131,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 2.0))
       ->capture_default_str();
   sub->add_option("--skin-border-bones", opt->skin_border_bones,
-                  "Which bones --skin-border separates: any two, or unrelated ones only (parent and child may merge)")
+                  "Which bones --skin-border separates: any two dominant joints, or unrelated ones only (parent and child may merge)")
       ->check(CLI::IsMember({"any", "unrelated"}))
       ->capture_default_str();
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");

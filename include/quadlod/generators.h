@@ -38,7 +38,7 @@ PolyMesh make_demo_vase(Index segments = 48, Index rings = 40);
 /// Weights: a vertex at height z belongs to bone ⌊z·bones/length⌋ alone, except within
 /// `blend` (a fraction of one bone's length) of a joint k >= 1, where it blends linearly from
 /// bone k−1 (weight 1 at z_k − blend·L/bones) to bone k (weight 1 at z_k + blend·L/bones); so
-/// every vertex has one or two influences and the lower half (z < z_1 − blend·L/bones) follows
+/// every vertex has one or two influences (blend 0: rigid weights, one each) and the lower half (z < z_1 − blend·L/bones) follows
 /// joint 0 only. One animation "bend", keyed at each of `frames` frames (1/24 s apart): every
 /// joint k >= 1 turns about +X from 0 to `max_angle_deg` linearly.
 SkinnedMesh make_bending_tube(Index around = 16, Index along = 24, Index bones = 2, double radius = 0.25,

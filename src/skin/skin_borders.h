@@ -13,7 +13,7 @@ namespace quadlod {
 struct SkinBorderParams {
   /// weight_distance() (total variation of the two weight vectors, in [0, 1]) above which an
   /// edge can be a border; SimplifyOptions::skin_border_distance.
-  double max_weight_distance = 0.5;
+  double max_weight_distance = 0.7;
   /// Parent per joint (kInvalidIndex: root); empty = distinct joints are never related.
   std::vector<Index> joint_parents;
 };
@@ -27,7 +27,8 @@ struct SkinBorders {
 };
 
 /// An edge (a, b) is a border when weight_distance(a, b) > max_weight_distance and the dominant
-/// joints of a and b (largest weight) are neither equal nor parent and child. Vertices without
+/// joints of a and b (largest weight) differ and, when joint_parents is given, are not parent and
+/// child. Vertices without
 /// influences border nothing. Precondition: mesh.skin covers the mesh (not empty).
 SkinBorders find_skin_borders(const PolyMesh& mesh, const Connectivity& conn, const SkinBorderParams& params);
 
