@@ -41,19 +41,16 @@ int run_animation_eval(const EvalOptions& opt, bool quiet) {
   if (!in.error.empty()) return fail(in.error);
   if (in.rig.empty() || in.mesh.skin.empty())
     return fail(opt.input + ": --animation needs a skinned input (a skinned glTF, or --rig FILE)");
-  PolyMesh output;
+  // OUTPUT's own weights when it is skinned (glTF, FBX, …; joints matched by name), else by the
+  // same projection onto INPUT that quadlod's reduction uses.
+  SkinnedInput out = read_skinned_input(opt.output, "");
+  if (!out.error.empty()) return fail(out.error);
+  PolyMesh output = std::move(out.mesh);
   std::string weights_from;
-  if (is_gltf_path(opt.output)) {
-    SkinnedReadResult out = read_skinned_gltf(opt.output);
-    if (!out.ok()) return fail(out.error);
-    if (std::string e = remap_joints(out.skinned.mesh, out.skinned.rig.skeleton, in.rig.skeleton); !e.empty())
-      return fail(opt.output + ": " + e);
-    output = std::move(out.skinned.mesh);
+  if (!output.skin.empty() && !out.rig.empty()) {
+    if (std::string e = remap_joints(output, out.rig.skeleton, in.rig.skeleton); !e.empty()) return fail(opt.output + ": " + e);
     weights_from = "its own";
   } else {
-    ReadResult out = read_mesh(opt.output);
-    if (!out.ok()) return fail(out.error);
-    output = std::move(out.mesh);
     output.skin = transfer_skin_weights(in.mesh, output).skin;
     weights_from = "projection onto the input";
   }

@@ -1,6 +1,7 @@
 #include "skin_cli.h"
 
 #include "quadlod/io.h"
+#include "quadlod/scene.h"
 
 #include <algorithm>
 #include <cctype>
@@ -26,6 +27,24 @@ SkinnedInput read_skinned_input(const std::string& path, const std::string& rig_
     in.mesh = std::move(r.skinned.mesh);
     in.rig = std::move(r.skinned.rig);
     in.material_colors = std::move(r.material_colors);
+  } else if (MeshFormat native; !format_from_path(path, native) && scene_readable_path(path)) {
+    // FBX, Collada, … through assimp (issue 21's reader): the first skinned mesh and the rig.
+    SceneReadResult r = read_scene(path);
+    if (!r.ok()) {
+      in.error = r.error;
+      return in;
+    }
+    const SceneMesh* skinned = nullptr;
+    for (const SceneMesh& m : r.scene.meshes)
+      if (!m.mesh.skin.empty() && !skinned) skinned = &m;
+    if (!skinned && !r.scene.meshes.empty()) skinned = &r.scene.meshes[0];
+    if (!skinned) {
+      in.error = path + ": the scene has no mesh";
+      return in;
+    }
+    in.mesh = skinned->mesh;
+    if (!in.mesh.skin.empty()) in.rig = r.scene.rig;
+    for (const SceneMaterial& m : r.scene.materials) in.material_colors.emplace_back(m.name, m.base_color);
   } else {
     ReadResult r = read_mesh(path);
     if (!r.ok()) {

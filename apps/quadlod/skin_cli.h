@@ -24,7 +24,8 @@ struct SkinnedInput {
 /// True for .glb / .gltf (case-insensitive).
 bool is_gltf_path(const std::string& path);
 
-/// Reads `path` (a skinned glTF through read_skinned_gltf, anything else through read_mesh).
+/// Reads `path`: a glTF through read_skinned_gltf, OBJ / PLY / OFF through read_mesh, any other
+/// scene format (FBX, Collada, …) through read_scene — its first skinned mesh with the scene's rig.
 /// With `rig_path` (a skinned glTF): its skeleton and animations are the rig, and a mesh without
 /// weights gets them by projection onto the rig file's mesh (transfer_skin_weights) — at the
 /// bind pose both are the same surface.
