@@ -18,7 +18,8 @@ namespace quadlod::scene_test {
 
 /// Grid: 8×6 quads over [0,2]×[0,1.5]; UV set "uvmap" = the generator's lattice in [0,1]², set
 /// "lightmap" = 0.5·uv + (0.25, 0.5) in [0.25,0.75]×[0.5,1]; material "red" for the 4 columns
-/// on the left (24 faces), "blue" for the rest (24); one shared +Z normal.
+/// on the left (24 faces), "blue" for the rest (24); one shared +Z normal; vertex colours
+/// (x / 2, 0.25, y / 1.5).
 /// Torus: 12×8 quads (96), the same two UV sets, material "blue".
 /// Nodes: root → grid_a (mesh 0, +1 in x) → grid_b (mesh 0 again: an instance, +2 in z);
 /// root → torus_c (mesh 1, scaled by 2).
@@ -37,6 +38,8 @@ inline Scene make_test_scene() {
   grid.material_names = {"red", "blue"};
   grid.face_material.resize(grid.num_faces());
   for (Index f = 0; f < grid.num_faces(); ++f) grid.face_material[f] = (f % 8) < 4 ? 0 : 1;
+  // Vertex colours: red rising along x, blue along y (k/8, k/6 are exact in float for the checks).
+  for (const Vec3& p : grid.positions) grid.vertex_colors.emplace_back(p.x() / 2.0, 0.25, p.y() / 1.5);
   PolyMesh torus = make_torus(12, 8);
   add_sets(torus);
   torus.material_names = {"blue"};

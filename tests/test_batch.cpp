@@ -23,7 +23,13 @@ class Batch : public ScratchDirTest {
   /// Seven tori of different sizes in dir/assets.
   void make_assets() {
     fs::create_directories(dir / "assets");
-    for (Index i = 0; i < 7; ++i) ASSERT_TRUE(write_mesh(make_torus(12 + 2 * i, 8), dir / "assets" / ("t" + std::to_string(i) + ".obj")).ok());
+    for (Index i = 0; i < 7; ++i) ASSERT_TRUE(write_mesh(make_torus(12 + 2 * i, 8), asset(i)).ok());
+  }
+  fs::path asset(Index i) const {
+    std::string name = "t";
+    name += std::to_string(i);
+    name += ".obj";
+    return dir / "assets" / name;
   }
   std::vector<nlohmann::json> lines(const std::string& out) {
     std::vector<nlohmann::json> parsed;
@@ -69,7 +75,7 @@ TEST_F(Batch, ThreeShardsDoEveryAssetExactlyOnce) {
   }
   ASSERT_EQ(done.size(), 7u);
   for (const auto& [input, times] : done) EXPECT_EQ(times, 1) << input;
-  for (Index i = 0; i < 7; ++i) EXPECT_TRUE(fs::exists(dir / "out" / ("t" + std::to_string(i) + ".obj")));
+  for (Index i = 0; i < 7; ++i) EXPECT_TRUE(fs::exists(dir / "out" / asset(i).filename()));
 
   // Resumable: a rerun of everything skips it all; touching one input redoes that one.
   fs::last_write_time(dir / "assets" / "t3.obj", fs::file_time_type::clock::now() + std::chrono::seconds(5));

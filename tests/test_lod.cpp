@@ -133,3 +133,47 @@ TEST_F(LodCli, ObjInObjOut) {
   const nlohmann::json report = nlohmann::json::parse(slurp(dir / "l" / "lods.json"));
   EXPECT_TRUE(report["levels"][0]["hausdorff"].is_null());
 }
+
+TEST(SimplifyScene, TargetSplitByTriangleEquivalentsOrPerMesh) {
+  const Scene scene = make_test_scene();  // grid 96, torus 192 triangle-equivalents
+  SceneSimplifyParams params;
+  params.options.progress = false;
+  params.options.target_tri_equivalent = 144;
+  const SceneSimplifyResult split = simplify_scene(scene, params);
+  ASSERT_TRUE(split.ok()) << split.error;
+  ASSERT_EQ(split.report["meshes"].size(), 2u);
+  EXPECT_EQ(split.report["meshes"][0]["target"].get<std::uint64_t>(), 48u);  // 144 · 96 / 288
+  EXPECT_EQ(split.report["meshes"][1]["target"].get<std::uint64_t>(), 96u);  // 144 · 192 / 288
+  EXPECT_EQ(split.target, 144u);
+  EXPECT_EQ(split.achieved, split.scene.tri_equivalent_count());
+  // Nodes and materials unchanged; the instanced grid reduced once.
+  EXPECT_EQ(split.scene.nodes.size(), scene.nodes.size());
+  EXPECT_EQ(split.scene.meshes.size(), 2u);
+  EXPECT_EQ(split.scene.nodes[1].meshes, split.scene.nodes[2].meshes);
+
+  params.per_mesh = true;
+  params.options.target_tri_equivalent = 80;
+  const SceneSimplifyResult each = simplify_scene(scene, params);
+  ASSERT_TRUE(each.ok()) << each.error;
+  EXPECT_EQ(each.report["meshes"][0]["target"].get<std::uint64_t>(), 80u);
+  EXPECT_EQ(each.report["meshes"][1]["target"].get<std::uint64_t>(), 80u);
+
+  EXPECT_FALSE(simplify_scene(Scene{}, params).ok());
+}
+
+TEST_F(LodCli, ObjLevelsElsewhereStillFindTheMtl) {
+  fs::create_directories(dir / "in");
+  PolyMesh grid = make_grid(8, 8);
+  grid.material_names = {"paint"};
+  grid.face_material.assign(grid.num_faces(), 0);
+  grid.material_libraries = {"g.mtl"};
+  ASSERT_TRUE(write_mesh(grid, dir / "in" / "g.obj").ok());
+  write_text(dir / "in" / "g.mtl", "newmtl paint\nKd 1 0 0\n");
+  const CliRun run = run_cli("-q lod '" + (dir / "in" / "g.obj").string() + "' -o '" + (dir / "out").string() +
+                                 "' --levels 0.5 --no-hausdorff", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const ReadResult level = read_mesh(dir / "out" / "g.lod1.obj");
+  ASSERT_TRUE(level.ok()) << level.error;
+  ASSERT_EQ(level.mesh.material_libraries.size(), 1u);
+  EXPECT_TRUE(fs::exists(dir / "out" / level.mesh.material_libraries[0])) << level.mesh.material_libraries[0];
+}

@@ -74,7 +74,9 @@ TEST_P(SceneRoundTrip, KeepsCountsMaterialsUvsAndNodes) {
   for (const SceneMaterial& m : back.materials) materials.insert(m.name);
   EXPECT_TRUE(materials.count("red") && materials.count("blue")) << ext;
   for (const SceneMaterial& m : back.materials)
-    if (m.name == "red") EXPECT_NEAR(m.base_color[0], 0.8, 1e-5) << ext;
+    if (m.name == "red") {
+      EXPECT_NEAR(m.base_color[0], 0.8, 1e-5) << ext;
+    }
 
   // Both UV sets with their ranges.
   ASSERT_EQ(grid_a->mesh.uv_sets.size(), 2u) << ext;
@@ -89,6 +91,12 @@ TEST_P(SceneRoundTrip, KeepsCountsMaterialsUvsAndNodes) {
   EXPECT_NEAR(lo1.y(), 0.5, 1e-6) << ext;
   EXPECT_NEAR(hi1.y(), 1.0, 1e-6) << ext;
   EXPECT_TRUE(grid_a->mesh.has_normals()) << ext;
+  // Vertex colours follow their vertices.
+  ASSERT_EQ(grid_a->mesh.vertex_colors.size(), grid_a->mesh.num_vertices()) << ext;
+  for (Index v = 0; v < grid_a->mesh.num_vertices(); ++v) {
+    const Vec3& p = grid_a->mesh.positions[v];
+    EXPECT_TRUE(grid_a->mesh.vertex_colors[v].isApprox(Vec3(p.x() / 2.0, 0.25, p.y() / 1.5), 1e-5)) << ext << " vertex " << v;
+  }
 
   // World placement: the flattened scene spans the instances and the scaled torus.
   const BoundingBox box = bounding_box(flatten_scene(back));
@@ -292,6 +300,7 @@ TEST(SceneFbx, BlenderImportsOurFbxWithItsQuads) {
              "bpy.ops.import_scene.fbx(filepath=sys.argv[sys.argv.index('--') + 1])\n"
              "q = t = n = 0\n"
              "names = sorted(o.name for o in bpy.context.scene.objects)\n"
+             "mats = sorted({m.name for o in bpy.context.scene.objects if o.type == 'MESH' for m in o.data.materials if m})\n"
              "for o in bpy.context.scene.objects:\n"
              "    if o.type != 'MESH': continue\n"
              "    for p in o.data.polygons:\n"
@@ -299,7 +308,7 @@ TEST(SceneFbx, BlenderImportsOurFbxWithItsQuads) {
              "        if k == 4: q += 1\n"
              "        elif k == 3: t += 1\n"
              "        else: n += 1\n"
-             "print('QUADLOD_COUNTS', q, t, n, ','.join(names))\n");
+             "print('QUADLOD_COUNTS', q, t, n, ','.join(names), ','.join(mats))\n");
   const std::string cmd = "blender -b --factory-startup --python '" + script.string() + "' -- '" +
                           (dir / "s.fbx").string() + "' > '" + (dir / "log").string() + "' 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
@@ -308,13 +317,15 @@ TEST(SceneFbx, BlenderImportsOurFbxWithItsQuads) {
   ASSERT_NE(at, std::string::npos) << log;
   std::istringstream in(log.substr(at + 14));
   std::uint64_t q = 0, t = 0, n = 0;
-  std::string names;
-  in >> q >> t >> n >> names;
+  std::string names, materials;
+  in >> q >> t >> n >> names >> materials;
   // Two grid instances (48 quads each) and the torus (96), all quads.
   EXPECT_EQ(q, 48u * 2 + 96u) << log.substr(at);
   EXPECT_EQ(t, 0u);
   EXPECT_EQ(n, 0u);
   for (const char* node : {"grid_a", "grid_b", "torus_c"}) EXPECT_NE(names.find(node), std::string::npos) << names;
+  EXPECT_NE(materials.find("red"), std::string::npos) << materials;
+  EXPECT_NE(materials.find("blue"), std::string::npos) << materials;
   fs::remove_all(dir);
 }
 
@@ -359,4 +370,33 @@ TEST(SceneWeld, NormalsWithinTheWeldAngleShareAnEntry) {
   exact.normal_weld_degrees = 0.0;
   const auto [e, f] = shared_vertex_normals(0.01, exact);
   EXPECT_NE(e, f);
+}
+
+TEST(SceneWeld, SurfacesOnTopOfEachOtherStayApart) {
+  // Two copies of a 3×2 grid at the same place (a doubled hair card) in one mesh: welding by
+  // position alone would make every face of the second copy a repeat of the first's.
+  PolyMesh doubled = make_grid(3, 2);
+  const PolyMesh copy = make_grid(3, 2);
+  const Index base = doubled.num_vertices();
+  for (const Vec3& p : copy.positions) doubled.add_vertex(p);
+  for (Index f = 0; f < copy.num_faces(); ++f) {
+    std::vector<Index> face;
+    for (Index v : copy.face_vertices(f)) face.push_back(base + v);
+    doubled.add_face(face);
+  }
+  const fs::path dir = scratch_dir("scene-doubled");
+  ASSERT_TRUE(write_scene(scene_from_mesh(doubled, "doubled"), dir / "d.dae").ok());
+  const SceneReadResult r = read_scene(dir / "d.dae");
+  fs::remove_all(dir);
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  const PolyMesh& back = r.scene.meshes[0].mesh;
+  EXPECT_EQ(back.num_faces(), 12u);
+  EXPECT_EQ(back.num_vertices(), 24u);
+  std::set<std::vector<Index>> faces;
+  for (Index f = 0; f < back.num_faces(); ++f) {
+    std::vector<Index> key(back.face_vertices(f).begin(), back.face_vertices(f).end());
+    std::sort(key.begin(), key.end());
+    EXPECT_TRUE(faces.insert(key).second) << "face " << f << " repeats an earlier face";
+  }
 }

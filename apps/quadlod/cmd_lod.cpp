@@ -94,7 +94,7 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                 {"screen_size_formula",
                  "screen_size = clamp(pixel_tolerance / (hausdorff_over_diagonal * screen_height_pixels), 0, 1), "
                  "non-increasing along the chain; the smallest over the meshes (docs/lod.md)"}};
-            const LodFilesResult written = write_lod_files(chain, dir, stem, ext, extra);
+            const LodFilesResult written = write_lod_files(chain, opt->input, dir, ext, extra);
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             if (!written.ok()) return fail(written.error);
             const auto num = [](const nlohmann::json& v) { return v.is_null() ? std::nan("") : v.get<double>(); };

@@ -28,6 +28,9 @@ int simplify_scene_file(const std::string& input, const std::string& output, con
   clock = Stopwatch();
   SceneSimplifyResult r = simplify_scene(in.scene, params);
   if (!r.ok()) return fail(input + ": " + r.error);
+  for (SceneMesh& mesh : r.scene.meshes)
+    if (!mesh.mesh.material_libraries.empty())
+      for (const std::string& w : rebase_material_libraries(mesh.mesh, input, output)) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const double reduce_seconds = clock.seconds();
   clock = Stopwatch();
   const WriteResult written = write_scene(r.scene, output);

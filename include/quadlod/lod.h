@@ -26,12 +26,13 @@ struct LodChainParams {
   std::vector<double> ratios{0.5, 0.25, 0.125};
   /// The reduction's options; `ratio` and `target_tri_equivalent` are set per level.
   SimplifyOptions simplify;
-  /// Measure each level's Hausdorff distance to the input (evaluate(), metrics.h) and derive
-  /// the switch threshold. false: hausdorff and screen_size are NaN.
+  /// Measure each level's Hausdorff distance to the input — evaluate()'s `hausdorff`
+  /// (metrics.h) for these samples and seed 1, without the rest of evaluate() — and derive the
+  /// switch threshold. false: hausdorff and screen_size are NaN.
   bool measure_hausdorff = true;
-  /// Surface samples per direction of that measurement (EvalParams::samples). 50000 keeps the
-  /// measurement well under the reduction's time on the corpus while the Hausdorff estimate
-  /// also includes every vertex of both meshes (EvalParams).
+  /// Surface samples per direction of that measurement (EvalParams::samples); every vertex of
+  /// both meshes is measured too. 50000 as a compromise of time and the estimate's resolution
+  /// (docs/lod.md has the measured cost).
   std::uint64_t hausdorff_samples = 50000;
   /// Screen-size rule (lod_screen_size): the level may be shown once its Hausdorff error
   /// projects to at most `pixel_tolerance` pixels on a screen `screen_height_pixels` tall.
@@ -128,10 +129,12 @@ struct LodFilesResult {
   bool ok() const { return error.empty(); }
 };
 
-/// Writes every level of `chain` (write_scene, atomically) to lod_file_path(dir, stem, l,
+/// Writes every level of `chain` (write_scene, atomically) to lod_file_path(dir, input's stem, l,
 /// extension), then `dir/lods.json` (the report, with `extra` merged in) last — so a present
-/// lods.json means the whole chain is there. Creates `dir`.
-LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& dir, const std::string& stem,
-                               const std::string& extension, const nlohmann::json& extra);
+/// lods.json means the whole chain is there. Creates `dir`. OBJ levels keep finding the input's
+/// MTL files (rebase_material_libraries, io.h; its warnings are returned).
+LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& input,
+                               const std::filesystem::path& dir, const std::string& extension,
+                               const nlohmann::json& extra);
 
 }  // namespace quadlod

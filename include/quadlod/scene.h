@@ -103,13 +103,14 @@ bool scene_readable_path(const std::filesystem::path& path);
 /// under one root node named after the file stem; every other extension goes through assimp.
 ///
 /// The assimp reader (src/io/assimp_read.cpp):
-///   * runs no triangulation and no vertex joining of its own: the meshes of one node (assimp
-///     splits a mesh by material) become one PolyMesh, whose vertices are the distinct corner
-///     positions (exact float equality) — the topology the exporter split at UV / normal / material
-///     seams comes back; a face whose vertices would all be those of an earlier face (surfaces
-///     lying on top of each other) gets vertices of its own instead — and whose UV sets (all of them, named when the file names them),
-///     normals and first colour set are pools with one index per corner (deduplicated by value;
-///     the normals of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
+///   * runs no triangulation and no vertex joining of assimp's: the meshes of one node (assimp
+///     splits a mesh by material) become one PolyMesh whose vertices come from gluing the corners
+///     along edges — two half-edges on the same two positions (exact float equality) running
+///     opposite ways make their faces neighbours — so the topology the exporter split at UV /
+///     normal / material seams comes back while parts that only touch, or lie on top of each
+///     other, stay apart; UV sets (all of them, named when the file names them), normals and the
+///     first colour set are pools with one index per corner (deduplicated by value; the normals
+///     of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
 ///   * drops points, lines and faces with fewer than 3 distinct corners (counted in
 ///     dropped_primitives);
 ///   * keeps the node hierarchy with local transforms (FBX pivot helpers folded), materials with

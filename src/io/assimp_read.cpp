@@ -2,19 +2,19 @@
 //
 // assimp hands over meshes whose vertices are split wherever a corner's attributes differ (and
 // FBX/glTF importers give every corner its own vertex), one aiMesh per material. quadlod's
-// reduction needs the surface's topology, so the meshes of one node are welded back together:
+// reduction needs the surface's topology, so the meshes of one node are glued back together:
 //
-//   aiMesh "body/mat A" ─┐   one PolyMesh: vertices = distinct corner positions,
-//   aiMesh "body/mat B" ─┼─► per-corner UV / normal pools (deduplicated by value),
-//                        │   face_material from each aiMesh's material
+//   aiMesh "body/mat A" ─┐   one PolyMesh: corners glued along edges with opposite half-edges
+//   aiMesh "body/mat B" ─┼─► on the same positions (glue_corners), per-corner UV / normal pools
+//                        │   (deduplicated by value), face_material from each aiMesh's material
 //
 // No post-process step triangulates or joins vertices (aiProcess_Triangulate /
-// JoinIdenticalVertices are not used): polygons stay polygons, and the welding here is exact
-// float equality of positions, which is what the exporter's split preserved.
+// JoinIdenticalVertices are not used): polygons stay polygons.
 //
 // Issue 24 (skins) adds bones / weights in `per_mesh_extras` and skeleton / animations in
 // `scene_extras`; nothing else here needs to change for it.
 #include "io/assimp_detail.h"
+#include "mesh/union_find.h"
 #include "quadlod/scene.h"
 
 #include <assimp/Importer.hpp>
@@ -31,7 +31,6 @@
 #include <cstring>
 #include <map>
 #include <unordered_map>
-#include <unordered_set>
 
 namespace quadlod {
 
@@ -54,14 +53,6 @@ FloatKey key_of(float x, float y, float z) {
   const auto b = [](float v) { return std::bit_cast<std::uint32_t>(v == 0.0f ? 0.0f : v); };
   return {{b(x), b(y), b(z)}};
 }
-
-struct IndexListHash {
-  std::size_t operator()(const std::vector<Index>& k) const {
-    std::uint64_t h = 1469598103934665603ull;
-    for (Index v : k) h = (h ^ v) * 1099511628211ull;
-    return static_cast<std::size_t>(h ^ (h >> 29));
-  }
-};
 
 /// A pool of values deduplicated by bit pattern.
 template <class Value>
@@ -183,7 +174,8 @@ class SceneBuilder {
     return id;
   }
 
-  /// The meshes of `group` as one PolyMesh (see the file comment).
+  /// The meshes of `group` as one PolyMesh (see the file comment): gather the faces, decide
+  /// which corners are one vertex (glue_corners), then build pools and faces.
   void weld(const std::vector<unsigned>& group, PolyMesh& mesh) {
     welded_of_.clear();  // issue 24: the map per_mesh_extras reads, for this group only
     unsigned uv_sets = 0;
@@ -194,43 +186,113 @@ class SceneBuilder {
       normals = normals || a.HasNormals();
       colours = colours || a.HasVertexColors(0);
     }
+    Corners corners = gather_corners(group);
+    Index vertex_count = 0;
+    const std::vector<Index> vertex_of = glue_corners(corners, vertex_count);
+
+    mesh.positions.resize(vertex_count);
+    std::vector<char> placed(vertex_count, 0);
+    if (colours) mesh.vertex_colors.assign(vertex_count, Vec3(1, 1, 1));
     mesh.uv_sets.resize(uv_sets);
     std::vector<Pool<Vec2>> uv_pools(uv_sets);
     for (unsigned k = 0; k < uv_sets; ++k) uv_pools[k].values = &mesh.uv_sets[k].values;
     Pool<Vec3> normal_pool{&mesh.normals, {}};
-    // Distinct positions, and per position the welded vertices standing on it ("layers"; more
-    // than one only where surfaces lie on top of each other, see place_face).
-    std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
-    std::vector<std::vector<Index>> layers;
-    std::unordered_set<std::vector<Index>, IndexListHash> faces_seen;
-    std::vector<std::vector<Index>> normals_at;  // per welded vertex: the normal entries its corners use
+    std::vector<std::vector<Index>> normals_at(vertex_count);  // per vertex: the normal entries its corners use
     std::map<std::string, Index> material_of;
-    std::vector<Index> face, chosen, key;
-
     for (unsigned m : group) {
       const aiMesh& a = *ai_.mMeshes[m];
       for (unsigned k = 0; k < uv_sets; ++k)
         if (mesh.uv_sets[k].name.empty() && a.HasTextureCoordsName(k))
           mesh.uv_sets[k].name = a.mTextureCoordsNames[k]->C_Str();
-      Index material = kInvalidIndex;
-      if (a.mMaterialIndex < scene_.materials.size()) {
-        const std::string& name = scene_.materials[a.mMaterialIndex].name;
-        auto [it, inserted] = material_of.try_emplace(name, static_cast<Index>(mesh.material_names.size()));
-        if (inserted) mesh.material_names.push_back(name);
-        material = it->second;
+    }
+    for (std::size_t f = 0; f + 1 < corners.face_offsets.size(); ++f) {
+      const Index begin = corners.face_offsets[f], end = corners.face_offsets[f + 1];
+      // Gluing can (rarely) bring two corners of one face onto one vertex: such a face is dropped.
+      bool repeated = false;
+      for (Index c = begin; c < end && !repeated; ++c)
+        for (Index d = c + 1; d < end && !repeated; ++d) repeated = vertex_of[c] == vertex_of[d];
+      if (repeated) {
+        ++scene_.dropped_primitives;
+        continue;
       }
-      // Position id of each aiMesh vertex.
+      const aiMesh& a = *ai_.mMeshes[corners.mesh[begin]];
+      std::vector<Index>& welded_of = welded_of_[&a];  // issue 24: for the bone weights
+      if (welded_of.empty()) welded_of.assign(a.mNumVertices, kInvalidIndex);
+      for (Index c = begin; c < end; ++c) {
+        const unsigned v = corners.vertex[c];
+        const Index w = vertex_of[c];
+        if (welded_of[v] == kInvalidIndex) welded_of[v] = w;
+        if (!placed[w]) {
+          placed[w] = 1;
+          mesh.positions[w] = Vec3(a.mVertices[v].x, a.mVertices[v].y, a.mVertices[v].z);
+          if (colours && a.HasVertexColors(0)) {
+            const aiColor4D& col = a.mColors[0][v];
+            mesh.vertex_colors[w] = Vec3(col.r, col.g, col.b);
+          }
+        }
+        mesh.corner_vertex.push_back(w);
+        for (unsigned k = 0; k < uv_sets; ++k) {
+          Index uv = kInvalidIndex;
+          if (a.HasTextureCoords(k)) {
+            const aiVector3D& t = a.mTextureCoords[k][v];
+            uv = uv_pools[k].add(key_of(t.x, t.y, 0.0f), Vec2(t.x, t.y));
+          }
+          mesh.uv_sets[k].corner.push_back(uv);
+        }
+        if (normals) {
+          Index n = kInvalidIndex;
+          if (a.HasNormals()) {
+            const aiVector3D& t = a.mNormals[v];
+            n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
+            n = weld_normal(mesh.normals, normals_at[w], n);
+          }
+          mesh.corner_normal.push_back(n);
+        }
+      }
+      mesh.face_offsets.push_back(mesh.num_corners());
+      if (!scene_.materials.empty()) {
+        Index material = kInvalidIndex;
+        if (a.mMaterialIndex < scene_.materials.size()) {
+          const std::string& name = scene_.materials[a.mMaterialIndex].name;
+          auto [it, inserted] = material_of.try_emplace(name, static_cast<Index>(mesh.material_names.size()));
+          if (inserted) mesh.material_names.push_back(name);
+          material = it->second;
+        }
+        mesh.face_material.push_back(material);
+      }
+    }
+    // Vertices only used by dropped faces: compact them away.
+    compact_unused(mesh, placed);
+    // Issue 24: the bone-weight map follows the compaction (compact_unused keeps the order).
+    std::vector<Index> new_id(placed.size(), kInvalidIndex);
+    for (Index v = 0, n = 0; v < placed.size(); ++v)
+      if (placed[v]) new_id[v] = n++;
+    for (auto& [ai_mesh, map] : welded_of_)
+      for (Index& w : map)
+        if (w != kInvalidIndex) w = new_id[w];
+  }
+
+  /// The faces of a group's aiMeshes as corners: which aiMesh, which of its vertices, which
+  /// distinct position. Consecutive corners on one position are merged; faces that still use a
+  /// position twice or have fewer than 3 corners are dropped (counted).
+  struct Corners {
+    std::vector<unsigned> mesh, vertex;
+    std::vector<Index> position;
+    std::vector<Index> face_offsets{0};
+  };
+  Corners gather_corners(const std::vector<unsigned>& group) {
+    Corners out;
+    std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
+    std::vector<unsigned> face;
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
       std::vector<Index> position(a.mNumVertices);
       for (unsigned v = 0; v < a.mNumVertices; ++v) {
         const aiVector3D& p = a.mVertices[v];
-        auto [it, inserted] = position_of.try_emplace(key_of(p.x, p.y, p.z), static_cast<Index>(layers.size()));
-        if (inserted) layers.emplace_back();
-        position[v] = it->second;
+        position[v] = position_of.try_emplace(key_of(p.x, p.y, p.z), static_cast<Index>(position_of.size())).first->second;
       }
       for (unsigned f = 0; f < a.mNumFaces; ++f) {
         const aiFace& af = a.mFaces[f];
-        // Corners (aiMesh vertex ids) with consecutive repeats removed; a face that still uses
-        // a position twice, or has fewer than 3 corners, is dropped (counted).
         face.clear();
         for (unsigned c = 0; c < af.mNumIndices; ++c) {
           const unsigned v = af.mIndices[c];
@@ -246,69 +308,87 @@ class SceneBuilder {
           ++scene_.dropped_primitives;
           continue;
         }
-        // Welding by position alone would make two faces lying exactly on top of each other (hair
-        // cards, doubled shells: separate vertices in the source) one face used twice. A face
-        // whose welded vertices are those of an earlier face goes one layer up instead, onto
-        // vertices of its own, and the faces after it that repeat faces of the lower layer
-        // follow it there — so a doubled surface comes back as two connected surfaces.
-        std::size_t layer = 0;
-        for (;; ++layer) {
-          key.clear();
-          for (unsigned v : face) {
-            if (layers[position[v]].size() <= layer) break;
-            key.push_back(layers[position[v]][layer]);
-          }
-          if (key.size() < face.size()) break;
-          std::sort(key.begin(), key.end());
-          if (!faces_seen.count(key)) break;
-        }
-        chosen.clear();
         for (unsigned v : face) {
-          std::vector<Index>& here = layers[position[v]];
-          if (here.size() > layer) {
-            chosen.push_back(here[layer]);
-            continue;
-          }
-          const aiVector3D& p = a.mVertices[v];
-          here.push_back(mesh.add_vertex(Vec3(p.x, p.y, p.z)));
-          normals_at.emplace_back();
-          if (colours) {
-            const aiColor4D c = a.HasVertexColors(0) ? a.mColors[0][v] : aiColor4D(1, 1, 1, 1);
-            mesh.vertex_colors.emplace_back(c.r, c.g, c.b);
-          }
-          chosen.push_back(here.back());
+          out.mesh.push_back(m);
+          out.vertex.push_back(v);
+          out.position.push_back(position[v]);
         }
-        key = chosen;
-        std::sort(key.begin(), key.end());
-        faces_seen.insert(key);
-        std::vector<Index>& welded_of = welded_of_[&a];  // issue 24: for the bone weights
-        if (welded_of.empty()) welded_of.assign(a.mNumVertices, kInvalidIndex);
-        for (std::size_t i = 0; i < face.size(); ++i) {
-          const unsigned v = face[i];
-          mesh.corner_vertex.push_back(chosen[i]);
-          if (welded_of[v] == kInvalidIndex) welded_of[v] = chosen[i];
-          for (unsigned k = 0; k < uv_sets; ++k) {
-            Index uv = kInvalidIndex;
-            if (a.HasTextureCoords(k)) {
-              const aiVector3D& t = a.mTextureCoords[k][v];
-              uv = uv_pools[k].add(key_of(t.x, t.y, 0.0f), Vec2(t.x, t.y));
-            }
-            mesh.uv_sets[k].corner.push_back(uv);
-          }
-          if (normals) {
-            Index n = kInvalidIndex;
-            if (a.HasNormals()) {
-              const aiVector3D& t = a.mNormals[v];
-              n = normal_pool.add(key_of(t.x, t.y, t.z), Vec3(t.x, t.y, t.z));
-              n = weld_normal(mesh.normals, normals_at[chosen[i]], n);
-            }
-            mesh.corner_normal.push_back(n);
-          }
-        }
-        mesh.face_offsets.push_back(mesh.num_corners());
-        if (!scene_.materials.empty()) mesh.face_material.push_back(material);
+        out.face_offsets.push_back(static_cast<Index>(out.position.size()));
       }
     }
+    return out;
+  }
+
+  /// Which corners are one vertex. Corners sharing an aiMesh vertex are (the file says so). Then
+  /// the surface is glued along its edges, not at its points:
+  ///
+  ///     face A  a0 ──► a1          two half-edges on the same two positions, running opposite
+  ///             b1 ◄── b0  face B  ways: A and B are neighbours, a0 ~ b1 and a1 ~ b0
+  ///
+  /// so a seam the exporter split comes back, while parts that only touch at a point, or lie on
+  /// top of each other, stay apart — welding by position would join them into non-manifold
+  /// vertices and edges, and doubled surfaces into repeated faces. Where more than two half-edges
+  /// share a position pair, each pairs with the first later opposite one in file order (a doubled
+  /// card: its own faces come next to each other). Half-edges running the same way are not
+  /// glued: that is how the boundaries of a doubled card meet, and the price is that a neighbour
+  /// with the opposite orientation comes back across a crack (two boundary edges) where the
+  /// source had one inconsistently oriented edge. Returns a vertex per corner, numbered by first
+  /// corner.
+  std::vector<Index> glue_corners(const Corners& corners, Index& vertex_count) const {
+    const Index n = static_cast<Index>(corners.position.size());
+    UnionFind sets(n);
+    std::unordered_map<std::uint64_t, Index> first_use;  // (aiMesh, vertex) → corner
+    for (Index c = 0; c < n; ++c) {
+      const std::uint64_t key = std::uint64_t{corners.mesh[c]} << 32 | corners.vertex[c];
+      const auto [it, inserted] = first_use.try_emplace(key, c);
+      if (!inserted) sets.unite(it->second, c);
+    }
+    // Half-edge c runs from corner c to the next corner of its face.
+    std::vector<Index> next(n);
+    for (std::size_t f = 0; f + 1 < corners.face_offsets.size(); ++f)
+      for (Index c = corners.face_offsets[f]; c < corners.face_offsets[f + 1]; ++c)
+        next[c] = c + 1 == corners.face_offsets[f + 1] ? corners.face_offsets[f] : c + 1;
+    std::unordered_map<std::uint64_t, std::vector<Index>> half_edges;  // position pair → half-edges, file order
+    for (Index c = 0; c < n; ++c) {
+      const Index p = corners.position[c], q = corners.position[next[c]];
+      half_edges[std::uint64_t{std::min(p, q)} << 32 | std::max(p, q)].push_back(c);
+    }
+    const auto glue = [&](Index c, Index d) {  // c runs p → q, d runs q → p
+      sets.unite(c, next[d]);
+      sets.unite(next[c], d);
+    };
+    std::vector<char> paired;
+    for (const auto& [key, list] : half_edges) {
+      if (list.size() < 2) continue;
+      paired.assign(list.size(), 0);
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        if (paired[i]) continue;
+        for (std::size_t j = i + 1; j < list.size(); ++j)
+          if (!paired[j] && corners.position[list[j]] == corners.position[next[list[i]]]) {
+            glue(list[i], list[j]);
+            paired[i] = paired[j] = 1;
+            break;
+          }
+      }
+    }
+    return sets.dense_labels(vertex_count);
+  }
+
+  /// Drops the vertices no kept face uses (`used` per vertex) and renumbers the corners.
+  static void compact_unused(PolyMesh& mesh, const std::vector<char>& used) {
+    if (std::all_of(used.begin(), used.end(), [](char u) { return u != 0; })) return;
+    std::vector<Index> new_id(used.size(), kInvalidIndex);
+    Index count = 0;
+    for (std::size_t v = 0; v < used.size(); ++v)
+      if (used[v]) {
+        new_id[v] = count;
+        mesh.positions[count] = mesh.positions[v];
+        if (!mesh.vertex_colors.empty()) mesh.vertex_colors[count] = mesh.vertex_colors[v];
+        ++count;
+      }
+    mesh.positions.resize(count);
+    if (!mesh.vertex_colors.empty()) mesh.vertex_colors.resize(count);
+    for (Index& v : mesh.corner_vertex) v = new_id[v];
   }
 
   /// The normal entry a corner of a vertex uses: an entry another corner of that vertex already

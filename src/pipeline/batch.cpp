@@ -190,7 +190,7 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
       if (!chain.ok()) return failed(job.input.string() + ": " + chain.error);
       const std::string ext = format.empty() ? default_output_extension(job.input) : format;
       const LodFilesResult files =
-          write_lod_files(chain, job.output, job.input.stem().string(), ext, {{"input", job.input.string()}});
+          write_lod_files(chain, job.input, job.output, ext, {{"input", job.input.string()}});
       if (!files.ok()) return failed(files.error);
       line["input_tri_equivalent"] = files.report["input_tri_equivalent"];
       line["levels"] = nlohmann::json::array();
@@ -203,8 +203,11 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
       SceneSimplifyParams scene_params;
       scene_params.options = simplify;
       scene_params.per_mesh = per_mesh;
-      const SceneSimplifyResult r = simplify_scene(in.scene, scene_params);
+      SceneSimplifyResult r = simplify_scene(in.scene, scene_params);
       if (!r.ok()) return failed(job.input.string() + ": " + r.error);
+      // OBJ outputs elsewhere keep finding the input's MTL files.
+      for (SceneMesh& mesh : r.scene.meshes)
+        if (!mesh.mesh.material_libraries.empty()) rebase_material_libraries(mesh.mesh, job.input, job.output);
       std::filesystem::create_directories(job.output.parent_path().empty() ? "." : job.output.parent_path(), ec);
       const WriteResult written = write_scene(r.scene, job.output);
       if (!written.ok()) return failed(written.error);

@@ -1,5 +1,7 @@
 // quadlod — LOD chains (include/quadlod/lod.h): level ℓ is simplify() of level ℓ − 1 aimed at
-// ratio_ℓ × the input's size, measured against the input with evaluate().
+// ratio_ℓ × the input's size, measured against the input (HausdorffToInput: evaluate()'s
+// Hausdorff distance, the input side built once).
+#include "pipeline/lod_distance.h"
 #include "quadlod/lod.h"
 #include "quadlod/metrics.h"
 
@@ -7,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace quadlod {
 
@@ -60,6 +63,7 @@ LodChainResult lod_chain(const PolyMesh& input, const LodChainParams& params) {
   const double diagonal = bounding_box(input).diagonal();
   const double longest = bounding_box(input).longest_side();
   const PolyMesh* previous = &input;
+  std::unique_ptr<lod_detail::HausdorffToInput> to_input;  // built at the first measurement
   for (double ratio : params.ratios) {
     LodLevel level;
     level.ratio = ratio;
@@ -98,14 +102,11 @@ LodChainResult lod_chain(const PolyMesh& input, const LodChainParams& params) {
     level.hausdorff = level.hausdorff_over_diagonal = level.screen_size = std::numeric_limits<double>::quiet_NaN();
     if (params.measure_hausdorff) {
       const auto measure_start = std::chrono::steady_clock::now();
-      EvalParams eval;
-      eval.samples = params.hausdorff_samples;
-      eval.curve_samples = std::max<std::uint64_t>(1, params.hausdorff_samples / 50);
-      eval.threads = params.simplify.threads > 0 ? static_cast<unsigned>(params.simplify.threads) : 0;
-      const EvalResult measured = evaluate(input, level.mesh, eval);
-      if (measured.ok() && diagonal > 0) {
-        level.hausdorff = measured.hausdorff;
-        level.hausdorff_over_diagonal = measured.hausdorff * longest / diagonal;
+      if (!to_input) to_input = std::make_unique<lod_detail::HausdorffToInput>(input, params.hausdorff_samples);
+      const double h = to_input->measure(level.mesh);
+      if (std::isfinite(h) && diagonal > 0) {
+        level.hausdorff = h;
+        level.hausdorff_over_diagonal = h * longest / diagonal;
         level.screen_size = lod_screen_size(level.hausdorff_over_diagonal, params.pixel_tolerance, params.screen_height_pixels);
         // A coarser level never switches in at a larger size than a finer one.
         if (!result.levels.empty() && std::isfinite(result.levels.back().screen_size))

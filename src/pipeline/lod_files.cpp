@@ -11,8 +11,10 @@ std::filesystem::path lod_file_path(const std::filesystem::path& dir, const std:
   return dir / (stem + ".lod" + std::to_string(level + 1) + extension);
 }
 
-LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& dir, const std::string& stem,
-                               const std::string& extension, const nlohmann::json& extra) {
+LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesystem::path& input,
+                               const std::filesystem::path& dir, const std::string& extension,
+                               const nlohmann::json& extra) {
+  const std::string stem = input.stem().string();
   LodFilesResult result;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -25,7 +27,11 @@ LodFilesResult write_lod_files(const SceneLodResult& chain, const std::filesyste
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t l = 0; l < chain.levels.size(); ++l) {
     const std::filesystem::path file = lod_file_path(dir, stem, l, extension);
-    const WriteResult written = write_scene(chain.levels[l], file);
+    Scene level_scene = chain.levels[l];
+    for (SceneMesh& mesh : level_scene.meshes)
+      if (!mesh.mesh.material_libraries.empty())
+        for (std::string& w : rebase_material_libraries(mesh.mesh, input, file)) result.warnings.push_back(std::move(w));
+    const WriteResult written = write_scene(level_scene, file);
     if (!written.ok()) {
       result.error = written.error;
       return result;
