@@ -1,6 +1,7 @@
 // Skin weights, skeletons, animations and linear blend skinning (issue 24): hand-computed poses,
 // the bind pose, weight projection, weights through the reduction, joint-influence borders.
 #include "quadlod/generators.h"
+#include "quadlod/io.h"
 #include "quadlod/simplify.h"
 #include "quadlod/skin.h"
 
@@ -10,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <unistd.h>
 #include <cmath>
 #include <numbers>
 
@@ -52,6 +55,20 @@ TEST(SkinWeights, CanonicalFormIsCheckedByTheLayout) {
   bad = mesh;
   bad.skin.offsets.pop_back();
   EXPECT_NE(bad.check_layout().find("vertices of weights for 4 vertices"), std::string::npos);
+}
+
+TEST(SkinWeights, ObjAndPlyIgnoreThem) {
+  const SkinnedMesh tube = make_bending_tube(6, 4, 2);
+  const auto dir = std::filesystem::temp_directory_path() / ("quadlod-skin-obj-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"tube.obj", "tube.ply"}) {
+    ASSERT_TRUE(write_mesh(tube.mesh, dir / name).ok());
+    const ReadResult r = read_mesh(dir / name);
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_TRUE(r.mesh.skin.empty());
+    EXPECT_EQ(r.mesh.num_vertices(), tube.mesh.num_vertices());
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SkinWeights, CanonicalInfluencesTruncateAndRenormalise) {

@@ -312,6 +312,18 @@ bpy.ops.export_scene.fbx(filepath=dst, add_leaf_bones=False, bake_anim=True, bak
   }
   EXPECT_LT(at_first, 1e-3 * size);
   EXPECT_GT(at_last, 0.2 * size);
+
+  // The CLI reduces the skinned FBX into a skinned .glb with the same skeleton and animation.
+  const fs::path lod = dir / "lod.glb";
+  const auto run = testing::run_cli("-q simplify '" + fbx.string() + "' -o '" + lod.string() + "' --ratio 0.5", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const SkinnedReadResult back = read_skinned_gltf(lod);
+  ASSERT_TRUE(back.ok()) << back.error;
+  EXPECT_EQ(back.skinned.mesh.check_layout(), "");
+  EXPECT_LT(back.skinned.mesh.num_faces(), mesh->num_faces());
+  EXPECT_EQ(back.skinned.rig.skeleton.num_joints(), rig.skeleton.num_joints());
+  ASSERT_EQ(back.skinned.rig.animations.size(), rig.animations.size());
+  EXPECT_EQ(back.skinned.rig.animations[0].frame_times().size(), frames.size());
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include "commands.h"
 
 #include "quadlod/io.h"
+#include "quadlod/scene.h"
 #include "skin_cli.h"
 #include "quadlod/simplify.h"
 #include "util/progress.h"
@@ -165,9 +166,16 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             Stopwatch clock;
             SkinnedInput in;
             bool skinned = !opt->rig.empty() || !opt->glb.empty();
+            MeshFormat native_in;
             if (!skinned && is_gltf_path(opt->input)) {
               in = read_skinned_input(opt->input, "");
               skinned = in.error.empty();
+            } else if (!skinned && is_gltf_path(opt->output) && !format_from_path(opt->input, native_in) &&
+                       scene_readable_path(opt->input)) {
+              // A skinned FBX / Collada of one mesh to .glb: its skin, skeleton and animations
+              // through assimp (docs/skinning.md); other scenes take the scene path below.
+              in = read_skinned_input(opt->input, "");
+              skinned = in.error.empty() && in.file_meshes == 1 && !in.mesh.skin.empty() && !in.rig.empty();
             } else if (skinned) {
               in = read_skinned_input(opt->input, opt->rig);
               if (!in.error.empty()) return fail(in.error);

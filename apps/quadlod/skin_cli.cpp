@@ -43,6 +43,7 @@ SkinnedInput read_skinned_input(const std::string& path, const std::string& rig_
       return in;
     }
     in.mesh = skinned->mesh;
+    in.file_meshes = r.scene.meshes.size();
     if (!in.mesh.skin.empty()) in.rig = r.scene.rig;
     for (const SceneMaterial& m : r.scene.materials) in.material_colors.emplace_back(m.name, m.base_color);
   } else {

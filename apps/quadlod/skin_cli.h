@@ -16,6 +16,8 @@ struct SkinnedInput {
   Rig rig;        ///< empty when neither the file nor --rig has one
   std::vector<std::pair<std::string, Eigen::Vector4d>> material_colors;
   std::string error;
+  /// Meshes in the file (1 for glTF through read_skinned_gltf and for OBJ / PLY / OFF).
+  std::size_t file_meshes = 1;
   /// Filled when the weights came by projection from the rig file's mesh.
   bool projected = false;
   SkinTransferResult transfer;
