@@ -5,7 +5,9 @@
 
 #include "mesh/connectivity.h"
 #include "mesh/validation.h"
+#include "quadlod/animation_metrics.h"
 #include "quadlod/io.h"
+#include "skin_cli.h"
 #include "quadlod/metrics.h"
 #include "util/progress.h"
 
@@ -24,7 +26,76 @@ struct EvalOptions {
   std::uint64_t seed = EvalParams{}.seed;
   double feature_tolerance = EvalParams{}.feature_tolerance;
   unsigned threads = 0;
+  // issue 24: metrics under animation
+  bool animation = false;
+  std::string rig;
+  Index animation_index = 0;
+  Index frame_step = 1;
+  bool samples_given = false;
 };
+
+// `eval --animation`: both meshes posed by the same skeleton at every frame (docs/metrics.md §7).
+int run_animation_eval(const EvalOptions& opt, bool quiet) {
+  Stopwatch clock;
+  SkinnedInput in = read_skinned_input(opt.input, opt.rig);
+  if (!in.error.empty()) return fail(in.error);
+  if (in.rig.empty() || in.mesh.skin.empty())
+    return fail(opt.input + ": --animation needs a skinned input (a skinned glTF, or --rig FILE)");
+  // OUTPUT's own weights when it is skinned (glTF, FBX, …; joints matched by name), else by the
+  // same projection onto INPUT that quadlod's reduction uses.
+  SkinnedInput out = read_skinned_input(opt.output, "");
+  if (!out.error.empty()) return fail(out.error);
+  PolyMesh output = std::move(out.mesh);
+  std::string weights_from;
+  if (!output.skin.empty() && !out.rig.empty()) {
+    if (std::string e = remap_joints(output, out.rig.skeleton, in.rig.skeleton); !e.empty()) return fail(opt.output + ": " + e);
+    weights_from = "its own";
+  } else {
+    output.skin = transfer_skin_weights(in.mesh, output).skin;
+    weights_from = "projection onto the input";
+  }
+  if (!quiet) std::fprintf(stderr, "eval: read both meshes and the rig in %.2f s\n", clock.seconds());
+  AnimationEvalParams params;
+  if (opt.samples_given) {
+    params.metrics.samples = opt.samples;
+    params.metrics.curve_samples = opt.samples;
+  }
+  params.metrics.seed = opt.seed;
+  params.metrics.threads = opt.threads;
+  params.metrics.feature_tolerance = opt.feature_tolerance;
+  params.animation = opt.animation_index;
+  params.frame_step = opt.frame_step;
+  const AnimationEvalResult r = evaluate_animation(in.mesh, output, in.rig, params);
+  if (!r.ok()) return fail(opt.output + ": " + r.error);
+  if (!quiet) std::fprintf(stderr, "eval: %zu frames in %.2f s\n", r.frames.size(), r.seconds);
+  if (opt.json) {
+    nlohmann::json j = to_json(r);
+    j["input"] = opt.input;
+    j["output"] = opt.output;
+    j["rig"] = opt.rig;
+    j["output_weights"] = weights_from;
+    j["input_weights"] = in.projected ? "projection onto the rig's mesh" : "its own";
+    j["samples"] = params.metrics.samples;
+    j["seed"] = params.metrics.seed;
+    std::printf("%s\n", j.dump(2).c_str());
+    return kExitOk;
+  }
+  std::printf("%s vs %s, animation %s (%zu frames; output weights: %s)\n", opt.output.c_str(), opt.input.c_str(),
+              r.animation.c_str(), r.frames.size(), weights_from.c_str());
+  std::printf("  %8s  %11s  %11s  %11s  %9s\n", "time s", "pccd", "chamfer", "hausdorff", "flow deg");
+  for (const AnimationFrame& f : r.frames)
+    std::printf("  %8.4f  %11.4e  %11.4e  %11.4e  %9.2f\n", f.time, f.metrics.pccd_defined ? f.metrics.pccd : std::nan(""),
+                f.metrics.chamfer, f.metrics.hausdorff, f.metrics.flow_deviation_deg);
+  auto line = [&](const char* name, const FrameSummary& s) {
+    std::printf("  %-15s median %.4e, worst %.4e (frame %d), mean %.4e\n", name, s.median, s.worst,
+                s.worst_frame == kInvalidIndex ? -1 : int(s.worst_frame), s.mean);
+  };
+  line("pccd", r.pccd);
+  line("chamfer", r.chamfer);
+  line("hausdorff", r.hausdorff);
+  line("flow deviation", r.flow_deviation_deg);
+  return kExitOk;
+}
 
 }  // namespace
 
@@ -44,7 +115,19 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--threads", opt->threads, "Worker threads (0 = all cores); results do not depend on it")
       ->capture_default_str();
-  return {sub, [opt, &global]() -> int {
+  sub->add_flag("--animation", opt->animation,
+                "Pose INPUT and OUTPUT with the same skeleton at every frame and report the metrics per frame "
+                "(INPUT: a skinned glTF or --rig; OUTPUT: a skinned glTF, or any mesh that takes weights by projection)");
+  sub->add_option("--rig", opt->rig, "With --animation: skinned glTF whose skeleton, animations and weights drive INPUT");
+  sub->add_option("--animation-index", opt->animation_index, "With --animation: which animation of the rig")->capture_default_str();
+  sub->add_option("--frame-step", opt->frame_step, "With --animation: every n-th frame")
+      ->check(CLI::Range(Index{1}, Index{100000}))
+      ->capture_default_str();
+  return {sub, [opt, &global, sub]() -> int {
+            if (!opt->animation && (!opt->rig.empty()))
+              return fail("--rig needs --animation");
+            opt->samples_given = sub->count("--samples") > 0;
+            if (opt->animation) return run_animation_eval(*opt, global.quiet);
             Stopwatch clock;
             const ReadResult in = read_mesh(opt->input);
             if (!in.ok()) return fail(in.error);

@@ -2,6 +2,8 @@
 #include "commands.h"
 
 #include "quadlod/io.h"
+#include "quadlod/scene.h"
+#include "skin_cli.h"
 #include "quadlod/simplify.h"
 #include "util/progress.h"
 #ifdef QUADLOD_HTML_REPORT
@@ -25,6 +27,8 @@ struct SimplifyCliOptions {
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false;
   bool per_mesh = false;
+  std::string rig, glb;  // issue 24: skinned input / skinned .glb output
+  std::string skin_border_bones = "any";
 };
 
 }  // namespace
@@ -127,6 +131,18 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
   sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
+  sub->add_option("--rig", opt->rig,
+                  "Skinned glTF whose skeleton and animations drive the mesh; an INPUT without weights takes "
+                  "them from its mesh by projection (docs/skinning.md)");
+  sub->add_option("--glb", opt->glb, "Also write the LOD as a skinned .glb with the rig's skeleton and animations");
+  sub->add_option("--skin-border", p.skin_border_distance,
+                  "Keep edges whose endpoints' weights differ by more than this and follow unrelated bones (> 1 = off)")
+      ->check(CLI::Range(0.0, 2.0))
+      ->capture_default_str();
+  sub->add_option("--skin-border-bones", opt->skin_border_bones,
+                  "Which bones --skin-border separates: any two dominant joints, or unrelated ones only (parent and child may merge)")
+      ->check(CLI::IsMember({"any", "unrelated"}))
+      ->capture_default_str();
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
 #ifdef QUADLOD_HTML_REPORT
   sub->add_option("--report-html", opt->report_html,
@@ -148,6 +164,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             if (!opt->report_html.empty() &&
                 (same_file(opt->output, opt->report_html) || (!opt->report.empty() && same_file(opt->report, opt->report_html))))
               return fail(opt->report_html + ": the HTML report and another output are the same file");
+            for (const std::string& out : {opt->glb})
+              if (!out.empty() && (same_file(opt->input, out) || same_file(opt->rig, out)))
+                return fail(out + ": refusing to overwrite an input");
             SimplifyOptions p = opt->pipeline;
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
@@ -160,16 +179,45 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.greedy_fallback = !opt->no_greedy_fallback;
             p.features = !opt->no_features;
             p.progress = !global.quiet;
-            // Scenes (FBX, glTF, Collada, … on either side) go mesh by mesh (cmd_scene.cpp).
+            // Skinned meshes (issue 24) take their own path: --rig / --glb, or a skinned glTF input
+            // (its skin, skeleton and animations carried through; a .glb output is written skinned).
+            Stopwatch clock;
+            SkinnedInput in;
+            bool skinned = !opt->rig.empty() || !opt->glb.empty();
+            MeshFormat native_in;
+            if (!skinned && is_gltf_path(opt->input)) {
+              in = read_skinned_input(opt->input, "");
+              skinned = in.error.empty();
+            } else if (!skinned && is_gltf_path(opt->output) && !format_from_path(opt->input, native_in) &&
+                       scene_readable_path(opt->input)) {
+              // A skinned FBX / Collada of one mesh to .glb: its skin, skeleton and animations
+              // through assimp (docs/skinning.md); other scenes take the scene path below.
+              in = read_skinned_input(opt->input, "");
+              skinned = in.error.empty() && in.file_meshes == 1 && !in.mesh.skin.empty() && !in.rig.empty();
+            } else if (skinned) {
+              in = read_skinned_input(opt->input, opt->rig);
+              if (!in.error.empty()) return fail(in.error);
+            }
             MeshFormat format, input_format;
-            if (!format_from_path(opt->output, format) || !format_from_path(opt->input, input_format)) {
+            const bool native_out = format_from_path(opt->output, format);
+            const bool glb_out = skinned && is_gltf_path(opt->output);
+            // Scenes (FBX, glTF, Collada, … on either side) go mesh by mesh (cmd_scene.cpp).
+            if (!skinned && (!native_out || !format_from_path(opt->input, input_format))) {
               if (!opt->report_html.empty())
                 return fail(opt->report_html + ": --report-html takes an OBJ, PLY or OFF input and output (use `quadlod report` on the meshes)");
               return simplify_scene_file(opt->input, opt->output, opt->report, p, opt->per_mesh);
             }
-            Stopwatch clock;
-            const ReadResult in = read_mesh(opt->input);
-            if (!in.ok()) return fail(in.error);
+            if (skinned && !native_out && !glb_out)
+              return fail(opt->output + ": a skinned mesh is written as .glb (or .obj / .ply / .off without its skin)");
+            if ((!opt->glb.empty() || glb_out) && (in.rig.empty() || in.mesh.skin.empty()))
+              return fail(opt->input + ": a skinned .glb output needs a skinned input (a skinned glTF, or --rig)");
+            if (!skinned) {
+              ReadResult plain = read_mesh(opt->input);
+              if (!plain.ok()) return fail(plain.error);
+              in.mesh = std::move(plain.mesh);
+            }
+            if (opt->skin_border_bones == "unrelated")
+              for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             const double read_seconds = clock.seconds();
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);
@@ -177,9 +225,15 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             for (const std::string& w : rebase_material_libraries(r.mesh, opt->input, opt->output))
               std::fprintf(stderr, "warning: %s\n", w.c_str());
             clock = Stopwatch();
-            const WriteResult written = write_mesh(r.mesh, opt->output);
+            const WriteResult written = glb_out ? write_skinned_glb(r.mesh, in.rig, opt->output, in.material_colors)
+                                                : write_mesh(r.mesh, opt->output);
             if (!written.ok()) return fail(written.error);
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+            if (!opt->glb.empty()) {
+              const WriteResult glb = write_skinned_glb(r.mesh, in.rig, opt->glb, in.material_colors);
+              if (!glb.ok()) return fail(glb.error);
+              r.report["glb"] = opt->glb;
+            }
             const double write_seconds = clock.seconds();
             r.report["input"] = opt->input;
             r.report["output"] = opt->output;

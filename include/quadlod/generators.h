@@ -5,6 +5,7 @@
 #pragma once
 
 #include "quadlod/mesh.h"
+#include "quadlod/skin.h"
 
 namespace quadlod {
 
@@ -30,5 +31,18 @@ PolyMesh make_cube(Index k = 1, double size = 1.0);
 /// quads and an n-gon all occur. `segments` (>= 3) quads around × `rings` (>= 1) along:
 /// segments·rings quads, `segments` triangles, one n-gon; closed, one component.
 PolyMesh make_demo_vase(Index segments = 48, Index rings = 40);
+
+/// A skinned test rig (issue 24): make_cylinder(around, along, radius, length) along +Z driven by
+/// a chain of `bones` (2 or 3) joints, joint k at z = k·length/bones (joint 0 the root at the
+/// origin, each a child of the one before), with inverse bind matrices of that rest pose.
+/// Weights: a vertex at height z belongs to bone ⌊z·bones/length⌋ alone, except within
+/// `blend` (a fraction of one bone's length) of a joint k >= 1, where it blends linearly from
+/// bone k−1 (weight 1 at z_k − blend·L/bones) to bone k (weight 1 at z_k + blend·L/bones); so
+/// every vertex has one or two influences (blend 0: rigid weights, one each) and the lower half (z < z_1 − blend·L/bones) follows
+/// joint 0 only. One animation "bend", keyed at each of `frames` frames (1/24 s apart): every
+/// joint k >= 1 turns about +X from 0 to `max_angle_deg` linearly.
+SkinnedMesh make_bending_tube(Index around = 16, Index along = 24, Index bones = 2, double radius = 0.25,
+                              double length = 2.0, double blend = 0.25, Index frames = 12,
+                              double max_angle_deg = 60.0);
 
 }  // namespace quadlod

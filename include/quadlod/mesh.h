@@ -54,6 +54,31 @@ struct UvSet {
   std::vector<Index> corner;   ///< per corner: pool index or kInvalidIndex
 };
 
+/// Skin weights (issue 24; include/quadlod/skin.h has the skeleton, animations and skinning):
+/// per vertex, any number of (joint, weight) influences as CSR — vertex v owns the entries
+/// [offsets[v], offsets[v+1]) of `joint` and `weight`. Empty (offsets empty) = the mesh is not
+/// skinned. Joints index the skeleton's joint list (Skeleton::joints). Kept canonical: within a
+/// vertex, weights are > 0, sorted by decreasing weight (ties by increasing joint), joints
+/// distinct, and they sum to 1 (within SkinWeights::kSumTolerance). A vertex may have no influence (it then follows no
+/// joint: glTF's "all weights zero", rare, kept as is). The OBJ / PLY / OFF paths ignore skins.
+struct SkinWeights {
+  std::vector<Index> offsets;  ///< num_vertices() + 1 entries when skinned, else empty
+  std::vector<Index> joint;
+  std::vector<double> weight;
+
+  /// How far a vertex's weights may sum from 1 (weights read from files are 32-bit floats).
+  static constexpr double kSumTolerance = 1e-5;
+
+  bool empty() const { return offsets.empty(); }
+  Index num_vertices() const { return offsets.empty() ? 0 : static_cast<Index>(offsets.size() - 1); }
+  Index influences(Index v) const { return offsets[v + 1] - offsets[v]; }
+  /// Largest number of influences of any vertex (0 when empty).
+  Index max_influences() const;
+  /// Checks the canonical form above for a mesh of `vertices` vertices; "" when it holds, else
+  /// the first violation naming the vertex ("skin: vertex 7: weights sum to 0.5").
+  std::string check(Index vertices) const;
+};
+
 /// A polygon mesh with optional per-corner UVs and normals and per-face tags.
 ///
 /// Invariants (checked by `check_layout()`):
@@ -64,7 +89,8 @@ struct UvSet {
 ///     (that corner has no UV in this set); corner_normal is empty (no normals) or likewise;
 ///   * face_object / face_group / face_material / face_smoothing are empty or one per face;
 ///     the first three index their name tables or are kInvalidIndex; smoothing 0 means "off";
-///   * vertex_colors is empty or one per vertex.
+///   * vertex_colors is empty or one per vertex;
+///   * skin is empty or covers every vertex in canonical form (SkinWeights::check).
 struct PolyMesh {
   // --- geometry -------------------------------------------------------------------------
   std::vector<Vec3> positions;
@@ -88,6 +114,9 @@ struct PolyMesh {
   std::vector<std::string> group_names;
   std::vector<std::string> material_names;
   std::vector<std::string> material_libraries;  ///< OBJ `mtllib` arguments, in file order
+
+  // --- skinning (issue 24) ----------------------------------------------------------------------
+  SkinWeights skin;  ///< per-vertex joint influences; empty when the mesh is not skinned
 
   // --- sizes ----------------------------------------------------------------------------------
   Index num_vertices() const { return static_cast<Index>(positions.size()); }

@@ -9,6 +9,7 @@
 
 #include "quadlod/io.h"
 #include "quadlod/mesh.h"
+#include "quadlod/skin.h"
 
 #include <Eigen/Core>
 
@@ -36,8 +37,8 @@ struct SceneMaterial {
 struct SceneMesh {
   std::string name;
   PolyMesh mesh;
-  // Room for issue 24 (skins): per-mesh bone weights go next to the mesh they deform, filled in
-  // by the one per-mesh hook of the assimp reader (src/io/assimp_read.cpp, "per-mesh extras").
+  // Skins (issue 24): mesh.skin holds the bone weights (joints index Scene::rig.skeleton), filled
+  // in by the assimp reader from glTF skins / FBX clusters (aiBone weights).
 };
 
 /// A node of the hierarchy. nodes[0] is the root when the scene has nodes.
@@ -56,7 +57,11 @@ struct Scene {
   /// line primitives); informational, for `quadlod info`-style summaries and for tests.
   Index cameras = 0, lights = 0, animations = 0;
   std::uint64_t dropped_primitives = 0;  ///< points / lines / faces with < 3 distinct corners
-  // Room for issue 24: skeleton and animations (read by the assimp reader's scene-level hook).
+  /// Skeleton and animations (issue 24): the joints are the nodes the meshes' bones name (plus
+  /// the nodes between them), with their hierarchy, local transforms as rest pose and the bones'
+  /// offset matrices as inverse bind matrices; animation channels on joints, times in seconds.
+  /// Empty when no mesh is skinned.
+  Rig rig;
 
   std::uint64_t tri_equivalent_count() const;
   /// The world transform of node n (product of the locals from the root down).

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace quadlod {
 
@@ -126,6 +127,20 @@ struct SimplifyOptions {
   /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7
   /// did; false = by their quadric (ClusterCollapseParams::place_on_hard_edges, measured).
   bool place_on_hard_edges = false;
+
+  // --- skinning (issue 24; docs/skinning.md) ----------------------------------------------------
+  /// With a skinned input (PolyMesh::skin): the output gets weights by projection onto the input
+  /// (transfer_skin_weights, include/quadlod/skin.h), and an edge is kept by the selection when
+  /// its endpoints' weight_distance() exceeds `skin_border_distance` and their dominant joints
+  /// differ (and, with skin_joint_parents, are not parent and child), so no cluster merges
+  /// across it. > 1 = off. 0.7 (measured on the ram walk against 0.5 and off, docs/skinning.md):
+  /// most of the weight changes hands across one edge — a rigid split such as eye | head.
+  double skin_border_distance = 0.7;
+  /// The skeleton's parent per joint (kInvalidIndex for roots): a parent and its child then
+  /// count as related and may merge across a border. Empty (the default, and the CLI's
+  /// --skin-border-bones any) = any two distinct dominant joints are separated: the ram's eyes
+  /// are children of its head, yet a face joining eye and head is its worst frame-by-frame error.
+  std::vector<Index> skin_joint_parents;
 
   // --- guarantees -------------------------------------------------------------------------------
   /// Bound on the distance of moved vertices from the input, relative to the bounding-box

@@ -177,6 +177,7 @@ class SceneBuilder {
   /// The meshes of `group` as one PolyMesh (see the file comment): gather the faces, decide
   /// which corners are one vertex (glue_corners), then build pools and faces.
   void weld(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    welded_of_.clear();  // issue 24: the map per_mesh_extras reads, for this group only
     unsigned uv_sets = 0;
     bool normals = false, colours = false;
     for (unsigned m : group) {
@@ -215,9 +216,12 @@ class SceneBuilder {
         continue;
       }
       const aiMesh& a = *ai_.mMeshes[corners.mesh[begin]];
+      std::vector<Index>& welded_of = welded_of_[&a];  // issue 24: for the bone weights
+      if (welded_of.empty()) welded_of.assign(a.mNumVertices, kInvalidIndex);
       for (Index c = begin; c < end; ++c) {
         const unsigned v = corners.vertex[c];
         const Index w = vertex_of[c];
+        if (welded_of[v] == kInvalidIndex) welded_of[v] = w;
         if (!placed[w]) {
           placed[w] = 1;
           mesh.positions[w] = Vec3(a.mVertices[v].x, a.mVertices[v].y, a.mVertices[v].z);
@@ -259,6 +263,13 @@ class SceneBuilder {
     }
     // Vertices only used by dropped faces: compact them away.
     compact_unused(mesh, placed);
+    // Issue 24: the bone-weight map follows the compaction (compact_unused keeps the order).
+    std::vector<Index> new_id(placed.size(), kInvalidIndex);
+    for (Index v = 0, n = 0; v < placed.size(); ++v)
+      if (placed[v]) new_id[v] = n++;
+    for (auto& [ai_mesh, map] : welded_of_)
+      for (Index& w : map)
+        if (w != kInvalidIndex) w = new_id[w];
   }
 
   /// The faces of a group's aiMeshes as corners: which aiMesh, which of its vertices, which
@@ -392,17 +403,147 @@ class SceneBuilder {
     return n;
   }
 
-  /// Issue 24: bones and weights of aiMesh `a` go into `out` here. An aiMesh vertex v lands on
-  /// the welded vertex of its position (on the layer of the faces using it, see weld()): record
-  /// that map in weld() next to `chosen` when the weights need it.
-  void per_mesh_extras(const aiMesh& a, SceneMesh& out) {}
-  /// Issue 24: skeleton (nodes already read) and ai_.mAnimations go here.
-  void scene_extras() {}
+  /// Issue 24: bones and weights of aiMesh `a` into out.mesh.skin (an aiMesh vertex maps to the
+  /// welded vertex its first face corner took in weld(), recorded in welded_of_). A welded vertex
+  /// that an earlier aiMesh of the group already weighted keeps those weights (the same vertex in
+  /// two primitives carries the same influences; adding both would count them twice).
+  void per_mesh_extras(const aiMesh& a, SceneMesh& out) {
+    if (!a.HasBones()) return;
+    PolyMesh& mesh = out.mesh;
+    const auto recorded = welded_of_.find(&a);
+    if (recorded == welded_of_.end()) return;  // no face of `a` survived the weld
+    const std::vector<Index>& welded_of = recorded->second;
+    std::vector<std::vector<Influence>> lists(mesh.num_vertices());
+    std::vector<std::uint8_t> weighted_before(mesh.num_vertices(), 0);
+    if (!mesh.skin.empty())
+      for (Index v = 0; v < mesh.num_vertices(); ++v) {
+        lists[v] = influences_of(mesh.skin, v);
+        weighted_before[v] = !lists[v].empty();
+      }
+    for (unsigned b = 0; b < a.mNumBones; ++b) {
+      const aiBone& bone = *a.mBones[b];
+      const Index joint = joint_of(bone.mName.C_Str(), to_eigen(bone.mOffsetMatrix));
+      for (unsigned w = 0; w < bone.mNumWeights; ++w) {
+        const aiVertexWeight& vw = bone.mWeights[w];
+        if (vw.mVertexId >= a.mNumVertices || !(vw.mWeight > 0.0f)) continue;
+        const Index welded = welded_of[vw.mVertexId];
+        if (welded == kInvalidIndex || weighted_before[welded]) continue;  // used by no face / weighted before
+        lists[welded].push_back({joint, vw.mWeight});
+      }
+    }
+    mesh.skin = make_skin_weights(lists);
+  }
+
+  /// The joint of a bone name, created on first use with the bone's offset matrix as B⁻¹.
+  Index joint_of(const std::string& name, const Eigen::Matrix4d& inverse_bind) {
+    auto [it, inserted] = joint_index_.try_emplace(name, static_cast<Index>(scene_.rig.skeleton.joints.size()));
+    if (inserted) {
+      Joint j;
+      j.name = name;
+      j.inverse_bind = inverse_bind;
+      scene_.rig.skeleton.joints.push_back(j);
+    }
+    return it->second;
+  }
+
+  bool source_is_gltf() const {
+    aiString format;
+    return ai_.mMetaData && ai_.mMetaData->Get("SourceAsset_Format", format) &&
+           std::string(format.C_Str()).find("glTF") != std::string::npos;
+  }
+
+  static Eigen::Matrix4d world_of(const aiNode* node) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    for (const aiNode* n = node; n; n = n->mParent) m = to_eigen(n->mTransformation) * m;
+    return m;
+  }
+
+  /// Issue 24: the skeleton from the nodes the bones name, and ai_.mAnimations on them.
+  void scene_extras() {
+    Skeleton& sk = scene_.rig.skeleton;
+    if (sk.joints.empty() || !ai_.mRootNode) return;
+    auto is_joint_below = [&](const aiNode* n) {  // some ancestor of n (n included) is a joint
+      for (; n; n = n->mParent)
+        if (joint_index_.count(n->mName.C_Str())) return true;
+      return false;
+    };
+    bool root_set = false;
+    // Joints grow while this runs: a non-joint node between two joints becomes a joint (no
+    // weights, identity B⁻¹) so that its transform stays in the chain.
+    for (Index j = 0; j < sk.joints.size(); ++j) {
+      const aiNode* node = ai_.mRootNode->FindNode(sk.joints[j].name.c_str());
+      if (!node) continue;  // a bone without a node: a root at the origin
+      aiVector3D scaling, position;
+      aiQuaternion rotation;
+      node->mTransformation.Decompose(scaling, rotation, position);
+      sk.joints[j].rest.translation = Vec3(position.x, position.y, position.z);
+      sk.joints[j].rest.rotation = Quat(rotation.w, rotation.x, rotation.y, rotation.z).normalized();
+      sk.joints[j].rest.scale = Vec3(scaling.x, scaling.y, scaling.z);
+      const aiNode* p = node->mParent;
+      if (p && is_joint_below(p)) {
+        sk.joints[j].parent = joint_of(p->mName.C_Str(), Eigen::Matrix4d::Identity());
+      } else if (!root_set) {
+        sk.root_transform = p ? world_of(p) : Eigen::Matrix4d::Identity();
+        root_set = true;
+      }
+    }
+    // Bind space. glTF binds in the skinned mesh's own space and ignores its node's transform
+    // (glTF 2.0 §3.7.3.3): the inverse bind matrices already map it. assimp's other importers
+    // (FBX clusters, Collada) give offset matrices from mesh space to bone space with the mesh
+    // node's world transform W applied by the skinning, so G·B⁻¹·v lands in world space; W⁻¹ in
+    // front of the roots brings the pose back to the mesh's space, and the bind pose gives the
+    // unposed mesh in both cases (skin.h's convention).
+    if (!source_is_gltf()) {
+      for (Index n = 0; n < scene_.nodes.size(); ++n) {
+        bool skinned = false;
+        for (Index m : scene_.nodes[n].meshes) skinned |= !scene_.meshes[m].mesh.skin.empty();
+        if (!skinned) continue;
+        sk.root_transform = scene_.world_transform(n).inverse() * sk.root_transform;
+        break;
+      }
+    }
+    for (unsigned a = 0; a < ai_.mNumAnimations; ++a) {
+      const aiAnimation& in = *ai_.mAnimations[a];
+      const double ticks = in.mTicksPerSecond > 0.0 ? in.mTicksPerSecond : 25.0;
+      Animation anim;
+      anim.name = in.mName.length ? in.mName.C_Str() : "animation" + std::to_string(a);
+      for (unsigned c = 0; c < in.mNumChannels; ++c) {
+        const aiNodeAnim& ch = *in.mChannels[c];
+        const auto it = joint_index_.find(ch.mNodeName.C_Str());
+        if (it == joint_index_.end()) continue;
+        AnimationChannel t, r, s;
+        t.joint = r.joint = s.joint = it->second;
+        t.path = AnimationChannel::Path::Translation;
+        r.path = AnimationChannel::Path::Rotation;
+        s.path = AnimationChannel::Path::Scale;
+        for (unsigned k = 0; k < ch.mNumPositionKeys; ++k) {
+          t.times.push_back(ch.mPositionKeys[k].mTime / ticks);
+          const aiVector3D& v = ch.mPositionKeys[k].mValue;
+          t.values.emplace_back(v.x, v.y, v.z, 0.0);
+        }
+        for (unsigned k = 0; k < ch.mNumRotationKeys; ++k) {
+          r.times.push_back(ch.mRotationKeys[k].mTime / ticks);
+          const aiQuaternion& q = ch.mRotationKeys[k].mValue;
+          r.values.emplace_back(q.x, q.y, q.z, q.w);
+        }
+        for (unsigned k = 0; k < ch.mNumScalingKeys; ++k) {
+          s.times.push_back(ch.mScalingKeys[k].mTime / ticks);
+          const aiVector3D& v = ch.mScalingKeys[k].mValue;
+          s.values.emplace_back(v.x, v.y, v.z, 0.0);
+        }
+        for (AnimationChannel* x : {&t, &r, &s})
+          if (!x->times.empty() && std::is_sorted(x->times.begin(), x->times.end())) anim.channels.push_back(std::move(*x));
+      }
+      if (!anim.channels.empty()) scene_.rig.animations.push_back(std::move(anim));
+    }
+  }
 
   const aiScene& ai_;
   const double normal_weld_cos_;
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
+  std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
+  std::map<const aiMesh*, std::vector<Index>> welded_of_;  // issue 24: aiMesh vertex → welded vertex
 };
 
 /// The post-processing steps: checks, and points / lines removed — nothing that triangulates,

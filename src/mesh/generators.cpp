@@ -1,5 +1,6 @@
 #include "quadlod/generators.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -176,6 +177,59 @@ PolyMesh make_demo_vase(Index segments, Index rings) {
   const Index f = mesh.add_face(lid);
   std::copy(lid_uv.begin(), lid_uv.end(), mesh.uv_sets[0].corner.begin() + mesh.face_begin(f));
   return mesh;
+}
+
+}  // namespace quadlod
+
+namespace quadlod {
+
+SkinnedMesh make_bending_tube(Index around, Index along, Index bones, double radius, double length,
+                              double blend, Index frames, double max_angle_deg) {
+  SkinnedMesh out;
+  out.mesh = make_cylinder(around, along, radius, length);
+  const double bone_length = length / bones;
+  Skeleton& skeleton = out.rig.skeleton;
+  for (Index k = 0; k < bones; ++k) {
+    Joint j;
+    j.name = "bone" + std::to_string(k);
+    j.parent = k == 0 ? kInvalidIndex : k - 1;
+    j.rest.translation = Vec3(0, 0, k == 0 ? 0.0 : bone_length);
+    Mat4 bind = Mat4::Identity();
+    bind(2, 3) = k * bone_length;  // the rest global of joint k
+    j.inverse_bind = bind.inverse();
+    skeleton.joints.push_back(j);
+  }
+  const double half = blend * bone_length;
+  std::vector<std::vector<Influence>> per_vertex(out.mesh.num_vertices());
+  for (Index v = 0; v < out.mesh.num_vertices(); ++v) {
+    const double z = out.mesh.positions[v].z();
+    Index bone = std::min<Index>(bones - 1, static_cast<Index>(std::floor(z / bone_length)));
+    per_vertex[v] = {{bone, 1.0}};
+    for (Index k = 1; k < bones; ++k) {
+      const double zk = k * bone_length;
+      if (std::abs(z - zk) < half) {
+        const double t = (z - (zk - half)) / (2.0 * half);
+        per_vertex[v] = {{k - 1, 1.0 - t}, {k, t}};
+      }
+    }
+  }
+  out.mesh.skin = make_skin_weights(per_vertex);
+  Animation bend;
+  bend.name = "bend";
+  for (Index k = 1; k < bones; ++k) {
+    AnimationChannel c;
+    c.joint = k;
+    c.path = AnimationChannel::Path::Rotation;
+    for (Index f = 0; f < frames; ++f) {
+      const double angle = frames > 1 ? max_angle_deg * std::numbers::pi / 180.0 * f / (frames - 1) : 0.0;
+      const Quat q(Eigen::AngleAxisd(angle, Vec3::UnitX()));
+      c.times.push_back(f / 24.0);
+      c.values.emplace_back(q.x(), q.y(), q.z(), q.w());
+    }
+    bend.channels.push_back(std::move(c));
+  }
+  out.rig.animations.push_back(std::move(bend));
+  return out;
 }
 
 }  // namespace quadlod

@@ -1,5 +1,6 @@
 #include "quadlod/mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -78,8 +79,42 @@ std::string PolyMesh::check_layout() const {
         check_tags(face_object, object_names.size(), num_faces(), "object", true),
         check_tags(face_group, group_names.size(), num_faces(), "group", true),
         check_tags(face_material, material_names.size(), num_faces(), "material", true),
-        check_tags(face_smoothing, 0, num_faces(), "smoothing", false)})
+        check_tags(face_smoothing, 0, num_faces(), "smoothing", false), skin.check(num_vertices())})
     if (!s.empty()) return s;
+  return {};
+}
+
+Index SkinWeights::max_influences() const {
+  Index most = 0;
+  for (Index v = 0; v < num_vertices(); ++v) most = std::max(most, influences(v));
+  return most;
+}
+
+std::string SkinWeights::check(Index vertices) const {
+  if (offsets.empty()) {
+    if (!joint.empty() || !weight.empty()) return "skin: influences without offsets";
+    return {};
+  }
+  if (offsets.size() != std::size_t(vertices) + 1)
+    return "skin: " + std::to_string(offsets.size() - 1) + " vertices of weights for " + std::to_string(vertices) + " vertices";
+  if (offsets.front() != 0 || offsets.back() != joint.size() || joint.size() != weight.size())
+    return "skin: offsets do not cover the " + std::to_string(joint.size()) + " influences";
+  for (Index v = 0; v < vertices; ++v) {
+    const std::string what = "skin: vertex " + std::to_string(v) + ": ";
+    if (offsets[v + 1] < offsets[v]) return what + "offsets decrease";
+    if (offsets[v + 1] == offsets[v]) continue;
+    double sum = 0.0;
+    for (Index i = offsets[v]; i < offsets[v + 1]; ++i) {
+      if (!(weight[i] > 0.0) || !std::isfinite(weight[i])) return what + "weight " + std::to_string(weight[i]) + " is not positive";
+      if (joint[i] == kInvalidIndex) return what + "invalid joint";
+      if (i > offsets[v] && (weight[i] > weight[i - 1] || (weight[i] == weight[i - 1] && joint[i] <= joint[i - 1])))
+        return what + "influences not sorted by decreasing weight";
+      for (Index k = offsets[v]; k < i; ++k)
+        if (joint[k] == joint[i]) return what + "joint " + std::to_string(joint[i]) + " twice";
+      sum += weight[i];
+    }
+    if (std::abs(sum - 1.0) > kSumTolerance) return what + "weights sum to " + std::to_string(sum);
+  }
   return {};
 }
 

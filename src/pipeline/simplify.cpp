@@ -9,6 +9,8 @@
 #include "post/dual_repair.h"
 #include "select/selection.h"
 #include "select/shape_selection.h"
+#include "skin/skin_borders.h"
+#include "quadlod/skin.h"
 #include "topology/analysis.h"
 #include "util/progress.h"
 
@@ -280,6 +282,23 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"pinned_edges", out.feature_pins},
         {"seconds", clock.seconds()},
     };
+  }
+  // Joint-influence borders (issue 24, docs/skinning.md): kept like the feature pins.
+  if (!input.skin.empty() && options.skin_border_distance <= 1.0) {
+    SkinBorderParams bp;
+    bp.max_weight_distance = options.skin_border_distance;
+    bp.joint_parents = options.skin_joint_parents;
+    const SkinBorders borders = find_skin_borders(input, conn, bp);
+    if (pinned.empty()) pinned.assign(conn.num_edges, 0);
+    Index added = 0;
+    for (Index e = 0; e < conn.num_edges; ++e)
+      if (borders.edge_border[e] && !pinned[e]) {
+        pinned[e] = 1;
+        ++added;
+      }
+    report["skin_borders"] = {{"border_edges", borders.border_edges},
+                              {"related_edges", borders.related_edges},
+                              {"pinned_edges", added}};
   }
   std::int64_t selection_target = static_cast<std::int64_t>(target);
   std::int64_t previous_target = 0, previous_achieved = 0;
@@ -660,13 +679,16 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     for (Index& f : last.face_source) f = face_origin[f];
     face_origin = std::move(last.face_source);
     current = std::move(last.mesh);
+    // Skin weights (issue 24): by projection onto the original input after every pass, so the
+    // next pass sees its joint-influence borders and the output carries weights.
+    if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
     pass_input = &current;
     if (pass >= planned &&
         std::abs(double(last.achieved) - n) <= options.round_tolerance * n)
       break;
     if (last.achieved <= result.target) break;
   }
-  for (const char* key : {"analysis", "features", "selection", "dual_repair", "collapse", "rounds"})
+  for (const char* key : {"analysis", "features", "skin_borders", "selection", "dual_repair", "collapse", "rounds"})
     if (last.report.contains(key)) report[key] = last.report[key];
   report["passes"] = std::move(passes);
   report["passes_planned"] = planned;
