@@ -10,6 +10,7 @@
 #include "mesh/validation.h"
 #include "quadlod/io.h"
 #include "quadlod/metrics.h"
+#include "quadlod/lod.h"
 #include "quadlod/simplify.h"
 
 #include <pybind11/stl.h>
@@ -167,20 +168,43 @@ SimplifyResult run_simplify(const PolyMesh& mesh, const SimplifyOptions& options
   return r;
 }
 
-/// The LOD chain: level k is reduced from level k − 1's output (level 0 from the input) to
-/// ratios[k] × the input's triangle-equivalents. Kept as one small function so that the library's
-/// lod_chain() (include/quadlod/lod.h, issue 21) can replace it at merge.
-std::vector<SimplifyResult> run_lod_chain(const PolyMesh& input, const std::vector<double>& ratios,
-                                          const SimplifyOptions& options) {
-  std::vector<SimplifyResult> levels;
-  const std::uint64_t input_size = tri_equivalent_count(input);
-  for (std::size_t k = 0; k < ratios.size(); ++k) {
-    SimplifyOptions level = options;
-    level.ratio = 1.0;
-    level.target_tri_equivalent = std::max<std::uint64_t>(1, std::llround(ratios[k] * double(input_size)));
-    levels.push_back(run_simplify(k == 0 ? input : levels.back().mesh, level));
+/// The LOD chain through the library's lod_chain() (include/quadlod/lod.h): level k reduced from
+/// level k − 1's output to ratios[k] × the input's triangle-equivalents, each level measured
+/// against the input (Hausdorff, screen-size switch threshold) unless measure_hausdorff is off.
+struct ChainLevel {
+  SimplifyResult result;
+  double hausdorff = 0.0, screen_size = 0.0;
+};
+std::vector<ChainLevel> run_lod_chain(const PolyMesh& input, const std::vector<double>& ratios,
+                                      const SimplifyOptions& options, bool measure_hausdorff) {
+  LodChainParams params;
+  params.ratios = ratios;
+  params.simplify = options;
+  params.measure_hausdorff = measure_hausdorff;
+  LodChainResult chain;
+  {
+    py::gil_scoped_release unlocked;
+    chain = lod_chain(input, params);
   }
-  return levels;
+  if (!chain.ok()) throw MeshInputError{chain.error};
+  std::vector<ChainLevel> out;
+  for (LodLevel& level : chain.levels) {
+    ChainLevel l;
+    SimplifyResult& r = l.result;
+    r.mesh = std::move(level.mesh);
+    r.report = std::move(level.report);
+    r.note = level.note;
+    r.input_tri_equivalent = chain.input_tri_equivalent;
+    r.target = level.target;
+    r.achieved = level.achieved;
+    r.quads = level.quads;
+    r.triangles = level.triangles;
+    r.ngons = level.ngons;
+    l.hausdorff = level.hausdorff;
+    l.screen_size = level.screen_size;
+    out.push_back(std::move(l));
+  }
+  return out;
 }
 
 py::dict evaluate_to_dict(const PolyMesh& input, const PolyMesh& output, const EvalParams& params) {
@@ -261,7 +285,7 @@ Raises QuadlodError with the CLI's message on bad input.)");
   m.def(
       "lod_chain",
       [](py::object vertices, py::object faces, py::object ratios, int levels, double ratio, py::object uvs,
-         py::object normals, py::object materials, py::kwargs kwargs) {
+         py::object normals, py::object materials, bool measure_hausdorff, py::kwargs kwargs) {
         SimplifyOptions options = options_from_kwargs(kwargs);
         std::vector<double> chain;
         if (!ratios.is_none()) chain = ratios.cast<std::vector<double>>();
@@ -272,23 +296,29 @@ Raises QuadlodError with the CLI's message on bad input.)");
         }
         if (chain.empty()) throw py::value_error("ratios: give at least one level");
         for (std::size_t k = 0; k < chain.size(); ++k)
-          if (!(chain[k] > 0 && chain[k] <= 1) || (k > 0 && chain[k] > chain[k - 1]))
-            throw py::value_error("ratios: each in (0, 1] and not above the previous level's");
+          if (!(chain[k] > 0 && chain[k] < 1) || (k > 0 && chain[k] >= chain[k - 1]))
+            throw py::value_error("ratios: each in (0, 1) and below the previous level's");
         options.ratio = chain.front();
         check_ranges(options);
         const PolyMesh mesh = mesh_from_arrays(vertices, faces, uvs, normals, materials);
         py::list out;
-        for (const SimplifyResult& r : run_lod_chain(mesh, chain, options))
-          out.append(result_to_dict(r, py::isinstance<py::dict>(uvs)));
+        for (const ChainLevel& level : run_lod_chain(mesh, chain, options, measure_hausdorff)) {
+          py::dict d = result_to_dict(level.result, py::isinstance<py::dict>(uvs));
+          d["hausdorff"] = level.hausdorff;
+          d["screen_size"] = level.screen_size;
+          out.append(d);
+        }
         return out;
       },
       py::arg("vertices"), py::arg("faces"), py::kw_only(), py::arg("ratios") = py::none(), py::arg("levels") = 3,
       py::arg("ratio") = 0.5, py::arg("uvs") = py::none(), py::arg("normals") = py::none(),
-      py::arg("materials") = py::none(),
+      py::arg("materials") = py::none(), py::arg("measure_hausdorff") = true,
       R"(An LOD chain: a list of simplify() results, level k reduced from level k - 1.
 
-ratios: each level's size as a fraction of the INPUT's triangle-equivalents, non-increasing
-(default: ratio ** k for k = 1..levels). Other arguments as simplify().)");
+ratios: each level's size as a fraction of the INPUT's triangle-equivalents, decreasing
+(default: ratio ** k for k = 1..levels). Each result also has 'hausdorff' (to the input, over its
+longest bbox side) and 'screen_size' (the switch threshold of docs/lod.md), NaN when
+measure_hausdorff is False. Other arguments as simplify().)");
 
   m.def(
       "read_mesh",

@@ -134,6 +134,16 @@ def test_lod_chain_reduces_each_level_from_the_previous():
     np.testing.assert_array_equal(again["vertices"], chain[1]["vertices"])
     explicit = quadlod.lod_chain(vertices, quads, ratios=[0.5, 0.25, 0.125], uvs=uvs, materials=materials)
     np.testing.assert_array_equal(explicit[2]["faces"], chain[2]["faces"])
+    # Each level measured against the input (the library's lod_chain, docs/lod.md): a coarser
+    # level strays further and may only be shown smaller on screen.
+    errors = [level["hausdorff"] for level in chain]
+    sizes = [level["screen_size"] for level in chain]
+    assert 0 < errors[0] <= errors[1] <= errors[2]
+    assert 1 >= sizes[0] >= sizes[1] >= sizes[2] > 0
+    unmeasured = quadlod.lod_chain(vertices, quads, levels=1, measure_hausdorff=False)
+    assert np.isnan(unmeasured[0]["hausdorff"])
+    with pytest.raises(ValueError):
+        quadlod.lod_chain(vertices, quads, ratios=[0.5, 0.5])
 
 
 def test_evaluate_matches_the_definitions_on_known_answers():
