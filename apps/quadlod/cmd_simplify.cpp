@@ -21,7 +21,15 @@ struct SimplifyCliOptions {
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false;
+  std::uint64_t max_memory = 0;  ///< bytes; 0 = no bound
 };
+
+std::string format_bytes(std::uint64_t bytes) {
+  char buf[64];
+  if (bytes >= (std::uint64_t{1} << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
+  else std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
+  return buf;
+}
 
 }  // namespace
 
@@ -115,6 +123,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-segmentation", opt->no_segmentation, "Ablation: whole poly-chords (§3.2.2 off)")->group("Ablations");
   sub->add_flag("--no-geometry", opt->no_geometry, "Ablation: drop Eqs. 6-8")->group("Ablations");
   sub->add_flag("--no-dual", opt->no_dual, "Ablation: skip the dual-graph repair (§3.3.1)")->group("Ablations");
+  sub->add_option("--max-memory", opt->max_memory,
+                  "Refuse (exit 2) an input whose estimated peak memory exceeds this (e.g. 2GiB, 512MB; 0 = no bound)")
+      ->transform(CLI::AsSizeValue(false))->group("Guarantees");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
   return {sub, [opt, ratio, faces, &global]() -> int {
             if (ratio->count() == 0 && faces->count() == 0) {
@@ -129,6 +140,17 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             MeshFormat format;
             if (!format_from_path(opt->output, format))
               return fail(opt->output + ": unknown output format (use .obj, .ply or .off)");
+            if (opt->max_memory > 0) {
+              // Before anything is allocated for the input (issue 23): counts from the header or
+              // one streaming pass, against the measured cost per triangle-equivalent.
+              const InputSizeEstimate size = estimate_input_size(opt->input);
+              if (!size.error.empty()) return fail(size.error);
+              const std::uint64_t need = estimate_simplify_peak_bytes(size);
+              if (need > opt->max_memory)
+                return fail(opt->input + ": simplify would need about " + format_bytes(need) + " (" +
+                            std::to_string(size.faces) + " faces, " + std::to_string(size.corners) +
+                            " corners claimed), more than --max-memory " + format_bytes(opt->max_memory));
+            }
             Stopwatch clock;
             const ReadResult in = read_mesh(opt->input);
             if (!in.ok()) return fail(in.error);

@@ -109,6 +109,33 @@ WriteResult write_off(const PolyMesh& mesh, const std::filesystem::path& path,
 std::vector<std::string> rebase_material_libraries(PolyMesh& mesh, const std::filesystem::path& input,
                                                    const std::filesystem::path& output);
 
+/// What a mesh file holds, found before reading it (issue 23: refuse an input that would exceed
+/// `--max-memory` before allocating for it). PLY and OFF: the header's element counts (corners
+/// assumed 4 per face: the header has none). OBJ: one streaming pass counting `v` and `f`
+/// records and the corners of the `f` records. Counts are what the file claims, not validated.
+struct InputSizeEstimate {
+  std::uint64_t file_bytes = 0;
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  std::uint64_t corners = 0;
+  std::string error;  ///< empty on success (unreadable file, unknown format)
+};
+InputSizeEstimate estimate_input_size(const std::filesystem::path& path);
+
+/// Peak memory of `quadlod simplify` as a function of the input: base + the file (held whole
+/// while parsing) + a cost per triangle-equivalent. Defaults measured on generated grids
+/// (docs/hostile_input.md, "Memory"), rounded up.
+struct MemoryModel {
+  std::uint64_t base_bytes = std::uint64_t{64} << 20;
+  double bytes_per_tri_equivalent = 800.0;
+};
+std::uint64_t estimate_simplify_peak_bytes(const InputSizeEstimate& input, const MemoryModel& model = {});
+
+/// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files
+/// write_file_atomically() is writing and then let the signal end the process, so an
+/// interrupted run leaves no partial output and no stray temp file (the CLI calls it first).
+void install_interrupt_cleanup();
+
 /// Writes `contents` to `path` atomically (temp file in the same directory + rename).
 /// Shared by the mesh writers and by every JSON/CSV report the tool writes.
 WriteResult write_file_atomically(const std::filesystem::path& path, std::string_view contents);
