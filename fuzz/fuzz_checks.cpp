@@ -125,7 +125,9 @@ PipelineCase decode_pipeline_case(std::string_view bytes) {
   }
   o.segmentation = !(flags & 4);
   o.dual_repair = !(flags & 8);
-  if (flags & 16) o.max_passes = 1;
+  // At most kMaxPipelinePasses passes (the default plans up to 32 at low ratios): each pass is
+  // the whole pipeline again, and a fuzz run wants many inputs more than many passes of one.
+  o.max_passes = (flags & 16) ? 1 : kMaxPipelinePasses;
   o.threads = 1;
   o.progress = false;
   const Index nv = 3 + Index{in.u8()};

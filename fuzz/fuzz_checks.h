@@ -34,7 +34,8 @@ std::string check_pipeline(std::string_view bytes);
 /// read as 0, so every input decodes to something):
 ///   byte 0        ratio = (b + 1) / 256
 ///   byte 1        flags: bit 0 features off, bit 1 objective "paper" (greedy, no MIP),
-///                 bit 2 no segmentation, bit 3 no dual repair, bit 4 one pass only
+///                 bit 2 no segmentation, bit 3 no dual repair, bit 4 one pass only (else
+///                 at most kMaxPipelinePasses passes)
 ///   byte 2        vertex count - 3 (3..258)
 ///   per vertex    3 × int16 little endian, coordinates in units of 1/256
 ///   then faces    one byte degree - 3 (degree 3..10, b % 8), then `degree` bytes, each a
@@ -45,6 +46,7 @@ struct PipelineCase {
   SimplifyOptions options;
 };
 inline constexpr Index kMaxPipelineFaces = 512;
+inline constexpr int kMaxPipelinePasses = 3;
 PipelineCase decode_pipeline_case(std::string_view bytes);
 
 /// The inverse of decode_pipeline_case for seeds: positions are rounded to the 1/256 grid

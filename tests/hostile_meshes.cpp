@@ -129,9 +129,10 @@ void chord_crossings(int crossings, std::vector<Vertex>& vertices, std::vector<F
 std::vector<HostileCase> catalogue() {
   std::vector<HostileCase> cases;
   const auto add = [&](std::string name, std::string ext, std::string description, Expect expect,
-                       std::string message_has, std::uint64_t faces, std::function<void(const fs::path&)> write) {
+                       std::string message_has, std::uint64_t faces, std::function<void(const fs::path&)> write,
+                       std::uint64_t vertices = 0) {
     cases.push_back({std::move(name), std::move(ext), std::move(description), expect, std::move(message_has), faces,
-                     std::move(write)});
+                     vertices, std::move(write)});
   };
   const auto refuse = Expect::Refusal;
   const auto either = Expect::RefusalOrOutput;
@@ -143,7 +144,7 @@ std::vector<HostileCase> catalogue() {
                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
                       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
       });
-  add("ply_header_2e31_faces", ".ply", "binary PLY header claims 2^31 - 1 faces, holds 1", refuse, "truncated", 1,
+  add("ply_header_2e31_faces", ".ply", "binary PLY header claims 2^31 - 1 faces, holds 1", refuse, "max-memory", 1,
       [](const fs::path& p) {
         std::ofstream out(p, std::ios::binary);
         out << "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -152,7 +153,7 @@ std::vector<HostileCase> catalogue() {
         put_le<std::uint8_t>(out, 3);
         for (std::int32_t i : {0, 1, 2}) put_le(out, i);
       });
-  add("off_header_2e31", ".off", "OFF header claims 2^31 vertices and faces", refuse, "32-bit", 0,
+  add("off_header_2e31", ".off", "OFF header claims 2^31 vertices and faces", refuse, "vertices", 0,
       [](const fs::path& p) { write_text(p, "OFF\n2147483648 2147483648 0\n0 0 0\n"); });
   add("obj_index_2e31_minus_1", ".obj", "OBJ face index 2^31 - 1 (3 vertices defined)", refuse, "vertex", 1,
       [](const fs::path& p) { write_text(p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483647\n"); });
@@ -239,7 +240,7 @@ std::vector<HostileCase> catalogue() {
       f.push_back({b, b + 1, b + 2, b + 3});
     }
     write_obj(p, v, f);
-  });
+  }, 400000);
   add("chord_crossing_1000", ".obj", "one closed poly-chord crossing itself 1000 times", either, "", 5000, [](const fs::path& p) {
     std::vector<Vertex> v;
     std::vector<Face> f;

@@ -23,6 +23,9 @@ struct HostileCase {
   Expect expect = Expect::RefusalOrOutput;
   std::string message_has;  ///< for refusals: a word the one-line message must contain
   std::uint64_t faces = 0;  ///< faces the file holds (the memory bound is per input face)
+  /// Vertices when there are more than faces (disconnected faces): most of the pipeline's memory
+  /// is per vertex, and the bound is taken per max(faces, vertices) (docs/hostile_input.md).
+  std::uint64_t vertices = 0;
   std::function<void(const std::filesystem::path&)> write;
 };
 

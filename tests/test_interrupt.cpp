@@ -92,7 +92,9 @@ TEST_F(Interrupt, KilledSimplifyLeavesNoPartialOutputAndNoTempFiles) {
       EXPECT_TRUE(fresh) << "the previous output was lost";
     }
     const std::vector<fs::path> left = temporaries(dir);
-    if (signal_number != SIGKILL) EXPECT_TRUE(left.empty()) << left.front();
+    if (signal_number != SIGKILL) {
+      EXPECT_TRUE(left.empty()) << left.front();
+    }
     for (const fs::path& p : left) fs::remove(p);  // SIGKILL cannot be caught: its temp file may stay
     if (!fresh) {
       std::ofstream(out, std::ios::binary) << previous;  // the next trial starts from the previous output
@@ -100,6 +102,42 @@ TEST_F(Interrupt, KilledSimplifyLeavesNoPartialOutputAndNoTempFiles) {
   }
   std::printf("interrupt: %d runs killed, %d finished first\n", killed, finished);
   EXPECT_GT(killed, 0);
+}
+
+// The moment that matters, hit on purpose: a signal while write_file_atomically() is writing
+// (its temp file exists) removes the temp file and leaves the previous file as it was.
+TEST_F(Interrupt, SignalDuringTheWriteRemovesTheTempFileAndKeepsThePreviousFile) {
+  const fs::path target = dir / "big.obj";
+  const std::string previous = "# the previous complete output\n";
+  int hit = 0;
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    SCOPED_TRACE("signal " + std::to_string(signal_number));
+    std::ofstream(target, std::ios::binary) << previous;
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      install_interrupt_cleanup();
+      const std::string contents(std::size_t{256} << 20, 'x');  // long enough to be caught writing
+      ::_exit(write_file_atomically(target, contents).ok() ? 0 : 1);
+    }
+    // Wait for the temp file to appear (the child allocates first), then signal.
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (temporaries(dir).empty() && std::chrono::steady_clock::now() < give_up) {
+      int status = 0;
+      if (::waitpid(pid, &status, WNOHANG) == pid) break;  // finished before we looked
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    ::kill(pid, signal_number);
+    const int status = wait_for(pid);
+    if (WIFSIGNALED(status)) {
+      ++hit;
+      EXPECT_EQ(WTERMSIG(status), signal_number);
+      EXPECT_EQ(slurp(target), previous);
+    } else {
+      EXPECT_EQ(fs::file_size(target), std::size_t{256} << 20);  // it won the race: complete
+    }
+    EXPECT_TRUE(temporaries(dir).empty());
+  }
+  EXPECT_GT(hit, 0) << "no signal landed during a write";
 }
 
 }  // namespace

@@ -131,25 +131,25 @@ bool Collapser::faces_input_surface(Index len, PositionOf&& at, const Vec3& av) 
 // members, that contain v.
 void Collapser::gather_fan(Index v) {
   fan_.clear();
+  fan_keys_.clear();
   ++fan_token_;
+  // Faces in the order the members' corners meet them, each face's pieces in buffer order (the
+  // order a scan of every piece would give). A piece holds each root at most once (rebuild_face
+  // cuts a face at a repeated root), so a corner of v's cluster marks exactly one fan entry.
+  Index rank = 0;
   for (Index m : members(v)) {
     for (Index c : conn_.corners_at_vertex(m)) {
       const Index f = conn_.corner_face[c];
-      if (face_fan_token_[f] == fan_token_) continue;
-      face_fan_token_[f] = fan_token_;
-      Index off = piece_base(f);
-      for (Index p = 0; p < piece_count_[f]; ++p) {
-        const Index len = piece_buf_[off];
-        const Index first = off + 1;
-        for (Index i = 0; i < len; ++i)
-          if (root_of_corner(piece_buf_[first + i]) == v) {
-            fan_.push_back({f, first, i, len});
-            break;
-          }
-        off = first + len;
+      if (face_fan_token_[f] != fan_token_) {
+        face_fan_token_[f] = fan_token_;
+        face_fan_rank_[f] = rank++;
       }
+      if (corner_piece_[c] != kInvalidIndex) fan_keys_.push_back({face_fan_rank_[f], corner_piece_[c], corner_piece_pos_[c]});
     }
   }
+  std::sort(fan_keys_.begin(), fan_keys_.end());
+  for (const auto& [face_rank, piece, pos] : fan_keys_)
+    fan_.push_back({conn_.corner_face[piece_buf_[piece + 1]], piece + 1, pos, piece_buf_[piece]});
 }
 
 // The definition of nonmanifold_vertices() (connectivity.h) for one input vertex, computed only

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <span>
 #include <utility>
+#include <array>
 #include <vector>
 
 namespace quadlod::collapse_detail {
@@ -147,6 +148,13 @@ class Collapser {
   // piece_base(f): [len, corner…, len, corner…]. Corners are input corner ids.
   std::vector<Index> piece_buf_;
   std::vector<Index> piece_count_;
+  // Where each input corner sits in piece_buf_: the offset of its piece's len slot and its place
+  // in the piece, or kInvalidIndex when the corner is in no piece. gather_fan() goes straight to
+  // the pieces of a cluster's corners instead of scanning every piece of every face around it,
+  // which is quadratic in the face size (a 100 000-gon took minutes; issue 23).
+  std::vector<Index> corner_piece_, corner_piece_pos_;
+  std::vector<std::array<Index, 3>> fan_keys_;  // gather_fan scratch: (face rank, piece offset, position)
+  std::vector<Index> face_fan_rank_;
   std::vector<std::uint32_t> face_tri_eq_;
   std::vector<std::uint8_t> face_pinched_;
   std::vector<std::uint8_t> face_blame_;  // refusal reason that made the face dirty this round
