@@ -84,7 +84,8 @@ ReadResult parse_obj(std::string_view text, const std::string& name, const ReadO
 ///   * OBJ: read → write → read reproduces the PolyMesh exactly when `precision` covers the
 ///     input's digits (17 always does); tags are emitted where they change between faces.
 ///     OBJ has one UV set: further sets are dropped with a warning.
-///   * PLY: float x y z (so coordinates round to float), nx ny nz only when every vertex has one
+///   * PLY: float x y z (so coordinates round to float; double when a coordinate is beyond float's
+///     range, likewise normals and each UV set), nx ny nz only when every vertex has one
 ///     normal shared by all its corners, uchar colours, per-corner UVs as a `texcoord` list per
 ///     UV set (`texcoord`, `texcoord1`, …; set names are not kept).
 ///     Face tags have no PLY form and are dropped.
