@@ -671,7 +671,7 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
   // Values beyond float's range go out as double: as float they would be infinite, a file this
   // reader refuses (issue 23, a fuzz finding), and the conversion itself is undefined.
   const auto beyond_float = [](double v) { return std::abs(v) > double(std::numeric_limits<float>::max()); };
-  const auto any_beyond = [&](const std::vector<auto>& values) {
+  const auto any_beyond = [&](const auto& values) {
     return std::any_of(values.begin(), values.end(), [&](const auto& x) {
       return std::any_of(x.data(), x.data() + x.size(), beyond_float);
     });
