@@ -75,7 +75,7 @@ void from_off_header(std::string_view head, InputSizeEstimate& e) {
       numbers.push_back(t);
     }
   }
-  if (numbers.size() == 2) {
+  if (numbers.size() >= 2) {  // vertices faces [edges]
     e.vertices = parse_count(numbers[0]);
     e.faces = parse_count(numbers[1]);
   }
