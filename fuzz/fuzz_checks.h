@@ -54,4 +54,10 @@ PipelineCase decode_pipeline_case(std::string_view bytes);
 /// (false).
 bool encode_pipeline_case(const PolyMesh& mesh, double ratio, std::uint8_t flags, std::string& out);
 
+/// The assimp front end (issue 21), where it exists (QUADLOD_FUZZ_HAS_SCENE: include/quadlod/
+/// scene.h is in the tree): read_scene_from_memory(bytes, hint) either fails with one line or
+/// returns meshes that pass check_layout() and nodes whose parents precede them and whose mesh
+/// indices exist. `hint` is the format's extension without the dot ("glb", "dae", "fbx").
+std::string check_scene(std::string_view hint, std::string_view bytes);
+
 }  // namespace quadlod::fuzz

@@ -6,9 +6,14 @@
 #include "io/io_common.h"
 #include "quadlod/generators.h"
 
+#ifdef QUADLOD_FUZZ_HAS_SCENE
+#include "quadlod/scene.h"
+#endif
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -75,6 +80,19 @@ int main(int argc, char** argv) {
       wo.ply_encoding = enc;
       if (io_detail::format_ply(mesh, wo, out, error)) save(root / "ply", name + "-" + tag + ".ply", out), ++written;
     }
+#ifdef QUADLOD_FUZZ_HAS_SCENE
+    // The assimp targets' seeds: the same meshes through quadlod's own scene writers.
+    for (const auto& [target, ext] : {std::pair{"assimp", ".glb"}, {"assimp_dae", ".dae"}, {"assimp_fbx", ".fbx"}}) {
+      const fs::path file = root / (std::string("scene-tmp") + ext);
+      fs::create_directories(root);
+      if (write_scene(scene_from_mesh(mesh, name), file).ok()) {
+        std::ifstream in(file, std::ios::binary);
+        save(root / target, name + ext, std::string(std::istreambuf_iterator<char>(in), {}));
+        ++written;
+      }
+      fs::remove(file);
+    }
+#endif
     for (const auto& [ratio, flags] : {std::pair{0.5, 0}, {0.25, 1}, {0.75, 2}, {0.1, 16}})
       if (fuzz::encode_pipeline_case(mesh, ratio, static_cast<std::uint8_t>(flags), out))
         save(root / "pipeline", name + "-" + std::to_string(int(ratio * 100)) + "-" + std::to_string(flags), out), ++written;

@@ -27,6 +27,13 @@ std::string run_target(const std::string& target, std::string_view bytes) {
   if (target == "ply") return fuzz::check_reader(MeshFormat::Ply, bytes);
   if (target == "off") return fuzz::check_reader(MeshFormat::Off, bytes);
   if (target == "pipeline") return fuzz::check_pipeline(bytes);
+#ifdef QUADLOD_FUZZ_HAS_SCENE
+  if (target == "assimp") return fuzz::check_scene("glb", bytes);
+  if (target == "assimp_dae") return fuzz::check_scene("dae", bytes);
+  if (target == "assimp_fbx") return fuzz::check_scene("fbx", bytes);
+#else
+  if (target.rfind("assimp", 0) == 0) return {};  // no scene reader in this tree
+#endif
   return "unknown target " + target;
 }
 
