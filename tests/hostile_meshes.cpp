@@ -144,7 +144,7 @@ std::vector<HostileCase> catalogue() {
                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
                       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
       });
-  add("ply_header_2e31_faces", ".ply", "binary PLY header claims 2^31 - 1 faces, holds 1", refuse, "max-memory", 1,
+  add("ply_header_2e31_faces", ".ply", "binary PLY header claims 2^31 - 1 faces, holds 1", refuse, "2147483647", 1,
       [](const fs::path& p) {
         std::ofstream out(p, std::ios::binary);
         out << "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -153,7 +153,7 @@ std::vector<HostileCase> catalogue() {
         put_le<std::uint8_t>(out, 3);
         for (std::int32_t i : {0, 1, 2}) put_le(out, i);
       });
-  add("off_header_2e31", ".off", "OFF header claims 2^31 vertices and faces", refuse, "vertices", 0,
+  add("off_header_2e31", ".off", "OFF header claims 2^31 vertices and faces", refuse, "2147483648", 0,
       [](const fs::path& p) { write_text(p, "OFF\n2147483648 2147483648 0\n0 0 0\n"); });
   add("obj_index_2e31_minus_1", ".obj", "OBJ face index 2^31 - 1 (3 vertices defined)", refuse, "vertex", 1,
       [](const fs::path& p) { write_text(p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483647\n"); });
