@@ -169,9 +169,14 @@ class AsciiReader {
       return Status::Malformed;
     } else if (t == PlyType::Float32 && std::isfinite(v)) {
       // A float property holds a float: "0.3" must read as 0.3f, as it does in binary files.
-      // Text beyond float's range is infinite as a float (converting it is undefined).
-      v = std::fabs(v) > double(std::numeric_limits<float>::max()) ? std::copysign(HUGE_VAL, v)
-                                                                   : double(static_cast<float>(v));
+      // Beyond float's range: what IEEE rounding gives, without an out-of-range conversion —
+      // FLT_MAX up to half an ulp above it (the shortest text of FLT_MAX, "3.4028235e+38", is
+      // above it), infinite from there (a fuzz finding: FLT_MAX did not survive an ascii trip).
+      constexpr double kFloatMax = std::numeric_limits<float>::max();
+      constexpr double kFloatOverflow = 0x1.ffffffp127;  // FLT_MAX + half an ulp: rounds to inf
+      const double a = std::fabs(v);
+      v = a <= kFloatMax ? double(static_cast<float>(v))
+                         : std::copysign(a < kFloatOverflow ? kFloatMax : HUGE_VAL, v);
     }
     p_ = token_end;
     return Status::Ok;
