@@ -35,11 +35,13 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   return dir;
 }
 
-/// Runs `quadlod ARGS` (ARGS is passed to the shell as is; quote paths with spaces).
-inline CliRun run_cli(const std::string& args, const std::filesystem::path& scratch) {
+/// Runs `quadlod ARGS` (ARGS is passed to the shell as is; quote paths with spaces). `wrapper`
+/// is put before the executable (e.g. "timeout 60").
+inline CliRun run_cli(const std::string& args, const std::filesystem::path& scratch,
+                      const std::string& wrapper = "") {
   const auto out = scratch / "cli.stdout";
   const auto err = scratch / "cli.stderr";
-  const std::string cmd = std::string("'") + QUADLOD_CLI_PATH + "' " + args + " >'" + out.string() +
+  const std::string cmd = wrapper + " '" + QUADLOD_CLI_PATH + "' " + args + " >'" + out.string() +
                           "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   CliRun run;

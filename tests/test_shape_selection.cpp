@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <unistd.h>
 
 #include <atomic>
@@ -314,7 +316,9 @@ TEST(ShapeSelection, ProgressCountsWorkAndIsThrottled) {
   options.ratio = 0.2;
   options.progress = true;
   ::testing::internal::CaptureStderr();
+  const auto start = std::chrono::steady_clock::now();
   const SimplifyResult r = simplify(make_demo_vase(), options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string err = ::testing::internal::GetCapturedStderr();
   ASSERT_TRUE(r.ok()) << r.error;
   ASSERT_GE(r.report["passes"].size(), 10u);
@@ -328,5 +332,7 @@ TEST(ShapeSelection, ProgressCountsWorkAndIsThrottled) {
     ++lines;
   }
   EXPECT_EQ(last, 100) << err;
-  EXPECT_LE(lines, 8) << err;  // the demo takes well under a second: the first and the final line
+  // The first and the final line, and at most one per 0.25 s between (StageLog's min_gap): the
+  // demo takes well under a second in Release, several under ASan on a loaded machine.
+  EXPECT_LE(lines, 8 + static_cast<int>(seconds / 0.25)) << err;
 }

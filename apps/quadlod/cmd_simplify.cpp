@@ -29,7 +29,15 @@ struct SimplifyCliOptions {
   bool per_mesh = false;
   std::string rig, glb;  // issue 24: skinned input / skinned .glb output
   std::string skin_border_bones = "any";
+  std::uint64_t max_memory = 0;  ///< bytes; 0 = no bound
 };
+
+std::string format_bytes(std::uint64_t bytes) {
+  char buf[64];
+  if (bytes >= (std::uint64_t{1} << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
+  else std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
+  return buf;
+}
 
 }  // namespace
 
@@ -143,6 +151,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                   "Which bones --skin-border separates: any two dominant joints, or unrelated ones only (parent and child may merge)")
       ->check(CLI::IsMember({"any", "unrelated"}))
       ->capture_default_str();
+  sub->add_option("--max-memory", opt->max_memory,
+                  "Refuse (exit 2) an input whose estimated peak memory exceeds this (e.g. 2GiB, 512MB; 0 = no bound)")
+      ->transform(CLI::AsSizeValue(false))->group("Guarantees");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
 #ifdef QUADLOD_HTML_REPORT
   sub->add_option("--report-html", opt->report_html,
@@ -167,6 +178,17 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             for (const std::string& out : {opt->glb})
               if (!out.empty() && (same_file(opt->input, out) || same_file(opt->rig, out)))
                 return fail(out + ": refusing to overwrite an input");
+            if (MeshFormat native; opt->max_memory > 0 && format_from_path(opt->input, native)) {
+              // Before anything is allocated for the input (issue 23): counts from the header or
+              // one streaming pass, against the measured cost per triangle-equivalent.
+              const InputSizeEstimate size = estimate_input_size(opt->input);
+              if (!size.error.empty()) return fail(size.error);
+              const std::uint64_t need = estimate_simplify_peak_bytes(size);
+              if (need > opt->max_memory)
+                return fail(opt->input + ": simplify would need about " + format_bytes(need) + " (" +
+                            std::to_string(size.faces) + " faces, " + std::to_string(size.corners) +
+                            " corners claimed), more than --max-memory " + format_bytes(opt->max_memory));
+            }
             SimplifyOptions p = opt->pipeline;
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;

@@ -1,8 +1,11 @@
 // quadlod command-line tool: dispatches to one subcommand (see commands.h, README "CLI reference").
 #include "commands.h"
 
+#include "quadlod/io.h"
+
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <vector>
 
 namespace quadlod::cli {
@@ -22,6 +25,8 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
 
 int main(int argc, char** argv) {
   using namespace quadlod::cli;
+  // An interrupted run leaves no temp file behind and the previous output intact (issue 23).
+  quadlod::install_interrupt_cleanup();
   CLI::App app{"quadlod — quad-dominant mesh reduction that keeps edge loops"};
   app.require_subcommand(1);
   app.fallthrough();  // global flags (-q) are accepted after the subcommand too
@@ -57,6 +62,10 @@ int main(int argc, char** argv) {
   try {
     for (const Command& command : commands)
       if (command.sub->parsed()) return command.run();
+  } catch (const std::bad_alloc&) {
+    // Not a bug but a limit of the machine: one line and the bad-input code, as --max-memory.
+    std::fprintf(stderr, "quadlod: out of memory (the input is too large for this machine; see --max-memory)\n");
+    return kExitBadInput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "quadlod: internal error: %s\n", e.what());
     return kExitInternal;

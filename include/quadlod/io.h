@@ -84,7 +84,8 @@ ReadResult parse_obj(std::string_view text, const std::string& name, const ReadO
 ///   * OBJ: read → write → read reproduces the PolyMesh exactly when `precision` covers the
 ///     input's digits (17 always does); tags are emitted where they change between faces.
 ///     OBJ has one UV set: further sets are dropped with a warning.
-///   * PLY: float x y z (so coordinates round to float), nx ny nz only when every vertex has one
+///   * PLY: float x y z (so coordinates round to float; double when a coordinate is beyond float's
+///     range, likewise normals and each UV set), nx ny nz only when every vertex has one
 ///     normal shared by all its corners, uchar colours, per-corner UVs as a `texcoord` list per
 ///     UV set (`texcoord`, `texcoord1`, …; set names are not kept).
 ///     Face tags have no PLY form and are dropped.
@@ -108,6 +109,33 @@ WriteResult write_off(const PolyMesh& mesh, const std::filesystem::path& path,
 /// several files is rewritten file by file. Nothing changes when both files share a directory.
 std::vector<std::string> rebase_material_libraries(PolyMesh& mesh, const std::filesystem::path& input,
                                                    const std::filesystem::path& output);
+
+/// What a mesh file holds, found before reading it (issue 23: refuse an input that would exceed
+/// `--max-memory` before allocating for it). PLY and OFF: the header's element counts (corners
+/// assumed 4 per face: the header has none). OBJ: one streaming pass counting `v` and `f`
+/// records and the corners of the `f` records. Counts are what the file claims, not validated.
+struct InputSizeEstimate {
+  std::uint64_t file_bytes = 0;
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  std::uint64_t corners = 0;
+  std::string error;  ///< empty on success (unreadable file, unknown format)
+};
+InputSizeEstimate estimate_input_size(const std::filesystem::path& path);
+
+/// Peak memory of `quadlod simplify` as a function of the input: base + the file (held whole
+/// while parsing) + a cost per triangle-equivalent. Defaults measured on generated grids
+/// (docs/hostile_input.md, "Memory"), rounded up.
+struct MemoryModel {
+  std::uint64_t base_bytes = std::uint64_t{64} << 20;
+  double bytes_per_tri_equivalent = 800.0;
+};
+std::uint64_t estimate_simplify_peak_bytes(const InputSizeEstimate& input, const MemoryModel& model = {});
+
+/// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files
+/// write_file_atomically() is writing and then let the signal end the process, so an
+/// interrupted run leaves no partial output and no stray temp file (the CLI calls it first).
+void install_interrupt_cleanup();
 
 /// Writes `contents` to `path` atomically (temp file in the same directory + rename).
 /// Shared by the mesh writers and by every JSON/CSV report the tool writes.

@@ -180,6 +180,13 @@ WriteResult write_file_atomically(const fs::path& path, std::string_view content
       static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count())};
   Fd f;
   fs::path tmp;
+  // The temp file's slot in the interrupt-cleanup registry, released on every way out (after
+  // the rename or the unlink: until then a signal must still remove the file).
+  int registered = -1;
+  struct Unregister {
+    int& slot;
+    ~Unregister() { io_detail::unregister_temporary(slot); }
+  } unregister{registered};
   for (int attempt = 0; attempt < 16 && f.fd < 0; ++attempt) {
     char suffix[64];
     const auto r = std::to_chars(suffix, suffix + sizeof suffix,
@@ -191,7 +198,11 @@ WriteResult write_file_atomically(const fs::path& path, std::string_view content
     tmp_name += '-';
     tmp_name.append(suffix, r.ptr);
     tmp = dir_or_cwd / tmp_name;
+    // Registered before it exists so that no signal can leave it behind (issue 23).
+    const int slot = io_detail::register_temporary(tmp.c_str());
     f.fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (f.fd >= 0) registered = slot;
+    else io_detail::unregister_temporary(slot);
     if (f.fd < 0 && errno != EEXIST) return fail(errno_message(errno));
   }
   if (f.fd < 0) return fail("cannot create a temporary file");

@@ -40,6 +40,12 @@ struct FileBuffer {
 /// ("cannot read a.obj: No such file or directory").
 bool read_whole_file(const std::filesystem::path& path, FileBuffer& out, std::string& error);
 
+/// The temp-file registry of install_interrupt_cleanup() (interrupt_cleanup.cpp): a temporary
+/// file registered here is removed when SIGINT / SIGTERM / SIGHUP ends the process. Returns a
+/// slot for unregister_temporary() (-1: not registered, e.g. too many at once).
+int register_temporary(const char* path);
+void unregister_temporary(int slot);
+
 /// Reads the file at `path` and runs `parse(text, name, options)`; `seconds` covers both.
 template <class Parse>
 ReadResult read_and_parse(const std::filesystem::path& path, const ReadOptions& options, Parse parse) {

@@ -169,7 +169,14 @@ class AsciiReader {
       return Status::Malformed;
     } else if (t == PlyType::Float32 && std::isfinite(v)) {
       // A float property holds a float: "0.3" must read as 0.3f, as it does in binary files.
-      v = static_cast<float>(v);
+      // Beyond float's range: what IEEE rounding gives, without an out-of-range conversion —
+      // FLT_MAX up to half an ulp above it (the shortest text of FLT_MAX, "3.4028235e+38", is
+      // above it), infinite from there (a fuzz finding: FLT_MAX did not survive an ascii trip).
+      constexpr double kFloatMax = std::numeric_limits<float>::max();
+      constexpr double kFloatOverflow = 0x1.ffffffp127;  // FLT_MAX + half an ulp: rounds to inf
+      const double a = std::fabs(v);
+      v = a <= kFloatMax ? double(static_cast<float>(v))
+                         : std::copysign(a < kFloatOverflow ? kFloatMax : HUGE_VAL, v);
     }
     p_ = token_end;
     return Status::Ok;
@@ -240,8 +247,10 @@ class PlyParser {
   struct TexcoordList {
     int property = -1;
     std::string name;
-    std::vector<float> values;
-    std::vector<float> face;  // the current face's list (may precede vertex_indices)
+    // Doubles: a `double texcoord` list (written for values beyond float's range) reads back
+    // exactly; a float list's values are floats already.
+    std::vector<double> values;
+    std::vector<double> face;  // the current face's list (may precede vertex_indices)
     std::size_t count = 0;
   };
   std::vector<TexcoordList> corner_texcoords_;
@@ -462,7 +471,7 @@ bool PlyParser::read_faces(Reader& reader, const PlyElement& e) {
         t->face.resize(count);
         for (std::uint64_t j = 0; j < count; ++j) {
           if (const Status s = reader.scalar(p.type, v); s != Status::Ok) return value_error(reader, s, e, i);
-          t->face[j] = static_cast<float>(v);
+          t->face[j] = v;
         }
         t->count = count;
       } else if (const Status s = reader.skip(p.type, count); s != Status::Ok) {
@@ -526,7 +535,7 @@ bool PlyParser::finish() {
     set.values.reserve(m.num_corners());
     set.corner.assign(m.num_corners(), kInvalidIndex);
     for (Index c = 0; c < m.num_corners(); ++c) {
-      const float u = t.values[2 * c], v = t.values[2 * c + 1];
+      const double u = t.values[2 * c], v = t.values[2 * c + 1];
       if (!std::isfinite(u) || !std::isfinite(v)) continue;
       set.corner[c] = static_cast<Index>(set.values.size());
       set.values.emplace_back(u, v);
@@ -571,6 +580,19 @@ class PlyWriter {
     } else {
       put(v);
     }
+  }
+  void f64(double v) {
+    if (ascii_) {
+      separate();
+      append_double(out_, v, 17);
+    } else {
+      put(v);
+    }
+  }
+  /// A value of a property written as double when `wide`, else as float.
+  void real(double v, bool wide) {
+    if (wide) f64(v);
+    else f32(static_cast<float>(v));
   }
   void u8(std::uint8_t v) {
     if (ascii_) {
@@ -651,6 +673,18 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
   const bool wide_count = max_degree > 255;
   const bool wide_texcoord_count = 2 * std::uint64_t{max_degree} > 255;
   const bool uint_index = mesh.num_vertices() > static_cast<Index>(std::numeric_limits<std::int32_t>::max());
+  // Values beyond float's range go out as double: as float they would be infinite, a file this
+  // reader refuses (issue 23, a fuzz finding), and the conversion itself is undefined.
+  const auto beyond_float = [](double v) { return std::abs(v) > double(std::numeric_limits<float>::max()); };
+  const auto any_beyond = [&](const auto& values) {
+    return std::any_of(values.begin(), values.end(), [&](const auto& x) {
+      return std::any_of(x.data(), x.data() + x.size(), beyond_float);
+    });
+  };
+  const bool wide_positions = any_beyond(mesh.positions);
+  const bool wide_normals = normals && any_beyond(vertex_normals);
+  std::vector<std::uint8_t> wide_uvs(mesh.uv_sets.size());
+  for (std::size_t k = 0; k < mesh.uv_sets.size(); ++k) wide_uvs[k] = any_beyond(mesh.uv_sets[k].values);
 
   out.clear();
   out += "ply\nformat ";
@@ -659,15 +693,19 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
                                                                  : "binary_little_endian";
   out += " 1.0\ncomment written by quadlod\nelement vertex ";
   append_uint(out, mesh.num_vertices());
-  out += "\nproperty float x\nproperty float y\nproperty float z\n";
-  if (normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  out += wide_positions ? "\nproperty double x\nproperty double y\nproperty double z\n"
+                        : "\nproperty float x\nproperty float y\nproperty float z\n";
+  if (normals)
+    out += wide_normals ? "property double nx\nproperty double ny\nproperty double nz\n"
+                        : "property float nx\nproperty float ny\nproperty float nz\n";
   if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   out += "element face ";
   append_uint(out, mesh.num_faces());
   out += wide_count ? "\nproperty list int " : "\nproperty list uchar ";
   out += uint_index ? "uint vertex_indices\n" : "int vertex_indices\n";
   for (std::size_t k = 0; k < mesh.uv_sets.size(); ++k) {
-    out += wide_texcoord_count ? "property list int float texcoord" : "property list uchar float texcoord";
+    out += wide_texcoord_count ? "property list int " : "property list uchar ";
+    out += wide_uvs[k] ? "double texcoord" : "float texcoord";
     if (k > 0) append_uint(out, k);
     out += '\n';
   }
@@ -681,9 +719,9 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
     return static_cast<std::uint8_t>(std::lround(std::clamp(std::isfinite(c) ? c : 0.0, 0.0, 1.0) * 255.0));
   };
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    for (int k = 0; k < 3; ++k) w.f32(static_cast<float>(mesh.positions[v][k]));
+    for (int k = 0; k < 3; ++k) w.real(mesh.positions[v][k], wide_positions);
     if (normals)
-      for (int k = 0; k < 3; ++k) w.f32(static_cast<float>(vertex_normals[v][k]));
+      for (int k = 0; k < 3; ++k) w.real(vertex_normals[v][k], wide_normals);
     if (colors)
       for (int k = 0; k < 3; ++k) w.u8(colour(mesh.vertex_colors[v][k]));
     w.end_record();
@@ -694,7 +732,8 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
     if (wide_count) w.i32(n);
     else w.u8(static_cast<std::uint8_t>(n));
     for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) w.i32(mesh.corner_vertex[c]);
-    for (const UvSet& set : mesh.uv_sets) {
+    for (std::size_t k = 0; k < mesh.uv_sets.size(); ++k) {
+      const UvSet& set = mesh.uv_sets[k];
       Index with_uv = 0;
       for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) with_uv += set.corner[c] != kInvalidIndex;
       const Index count = with_uv == 0 ? 0 : 2 * n;
@@ -703,8 +742,8 @@ bool format_ply(const PolyMesh& mesh, const WriteOptions& options, std::string& 
       if (count)
         for (Index c = mesh.face_begin(f); c < mesh.face_end(f); ++c) {
           const Index t = set.corner[c];
-          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(set.values[t].x()));
-          w.f32(t == kInvalidIndex ? kNaN : static_cast<float>(set.values[t].y()));
+          w.real(t == kInvalidIndex ? kNaN : set.values[t].x(), wide_uvs[k]);
+          w.real(t == kInvalidIndex ? kNaN : set.values[t].y(), wide_uvs[k]);
         }
     }
     w.end_record();

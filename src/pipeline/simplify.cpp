@@ -408,7 +408,10 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"stop_reason", selection.stop_reason},
     };
     const double distance = std::abs(double(drift));
-    const bool better = distance < best_distance;
+    // A collapse that leaves no face is no output at all (a file of it does not read back):
+    // never chosen, whatever its distance; the re-aim below moves the next round up (issue 23,
+    // tests/fuzz_regressions/pipeline: a 6 × 4 torus at 0.1 in one pass).
+    const bool better = distance < best_distance && collapsed.mesh.num_faces() > 0;
     round_json["chosen"] = better;
     if (better) {
       for (auto& r : rounds) r["chosen"] = false;
@@ -483,6 +486,14 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
                              {"select", out.seconds_select},
                              {"dual", out.seconds_dual},
                              {"collapse", out.seconds_collapse}};
+  if (!best) {
+    // Every round emptied the mesh: the pass keeps its input.
+    best.emplace();
+    best->mesh = input;
+    best->face_source.resize(input.num_faces());
+    std::iota(best->face_source.begin(), best->face_source.end(), Index{0});
+    out.rounds_used = 0;
+  }
   out.mesh = std::move(best->mesh);
   out.face_source = std::move(best->face_source);
   out.achieved = tri_equivalent_count(out.mesh);

@@ -407,8 +407,15 @@ void Collapser::rebuild_face(Index f) {
   Index pieces = 0;
   std::uint32_t tri_eq = 0;
   bool pinched = false;
+  const bool indexed = !corner_piece_.empty();
+  if (indexed) std::fill(corner_piece_.begin() + b, corner_piece_.begin() + b + k, kInvalidIndex);
   auto emit = [&](const Index* cs, Index len) {
     if (len < 3) return;
+    if (indexed)
+      for (Index i = 0; i < len; ++i) {
+        corner_piece_[cs[i]] = out;
+        corner_piece_pos_[cs[i]] = i;
+      }
     piece_buf_[out++] = len;
     for (Index i = 0; i < len; ++i) piece_buf_[out++] = cs[i];
     ++pieces;
@@ -453,6 +460,13 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
   face_blame_.assign(nf_, kNoReason);
   piece_buf_.assign(2 * static_cast<std::size_t>(mesh_.num_corners()), 0);
   piece_count_.assign(nf_, 0);
+  Index max_degree = 0;
+  for (Index f = 0; f < nf_; ++f) max_degree = std::max(max_degree, mesh_.face_size(f));
+  if (max_degree > kIndexedFanDegree) {
+    corner_piece_.assign(mesh_.num_corners(), kInvalidIndex);
+    corner_piece_pos_.assign(mesh_.num_corners(), 0);
+    face_fan_rank_.assign(nf_, 0);
+  }
   face_tri_eq_.assign(nf_, 0);
   face_pinched_.assign(nf_, 0);
 

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <span>
 #include <utility>
+#include <array>
 #include <vector>
 
 namespace quadlod::collapse_detail {
@@ -80,6 +81,7 @@ class Collapser {
   template <class PositionOf>
   bool faces_input_surface(Index len, PositionOf&& at, const Vec3& av) const;
   void gather_fan(Index v);
+  void gather_fan_indexed(Index v);
   void blame(Index r, CollapseRefusal why);
   void blame_piece(const Index* corners, Index len, CollapseRefusal why);
   bool same_input_vertex_set(Index f, Index g);
@@ -157,6 +159,14 @@ class Collapser {
   // piece_base(f): [len, corner…, len, corner…]. Corners are input corner ids.
   std::vector<Index> piece_buf_;
   std::vector<Index> piece_count_;
+  // Only for meshes with a face above kIndexedFanDegree corners (empty otherwise: no memory for
+  // quad meshes): where each input corner sits in piece_buf_, the offset of its piece's len slot
+  // and its place in the piece, or kInvalidIndex when the corner is in no piece (see
+  // gather_fan_indexed).
+  static constexpr Index kIndexedFanDegree = 32;
+  std::vector<Index> corner_piece_, corner_piece_pos_;
+  std::vector<std::array<Index, 3>> fan_keys_;  // gather_fan scratch: (face rank, piece offset, position)
+  std::vector<Index> face_fan_rank_;
   std::vector<std::uint32_t> face_tri_eq_;
   std::vector<std::uint8_t> face_pinched_;
   std::vector<std::uint8_t> face_blame_;  // refusal reason that made the face dirty this round

@@ -220,7 +220,10 @@ class Repairer {
       heap.push({0.0, begin});
       std::vector<Index> ends;
       while (!heap.empty() && ends.size() < kMaxEnds) {
-        const auto [d, f] = heap.top();
+        // Plain variables, not a structured binding: the lambda below captures them, which
+        // clang before 16 (the fuzz tree's clang-15) refuses for bindings.
+        const double d = heap.top().first;
+        const Index f = heap.top().second;
         heap.pop();
         const std::size_t lf = local(f);
         if (d > dist[lf]) continue;
