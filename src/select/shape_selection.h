@@ -84,8 +84,9 @@ struct ShapeSelectionParams {
   /// Threads of the first pricing of all candidates (the greedy itself is sequential); 0 = all
   /// cores. Speed only: the selection is the same for any value.
   int threads = 0;
-  /// Below this many candidates the first pricing runs on one thread (measured: on the 500-face
-  /// suzanne a second thread's start and scratch cost more than its share of the pricing).
+  /// Below this many candidates the first pricing runs on one thread: a thread's start and its
+  /// scratch (arrays per vertex and per face) are not worth it on a small mesh, whose whole
+  /// pricing takes milliseconds. Not tuned (speed only; the selection is the same either way).
   std::size_t min_parallel_candidates = 20000;
 };
 
