@@ -150,18 +150,7 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
               j["output"] = opt->output;
               j["tri_equivalent_in"] = r.counts_in.tri_equivalent;
               j["tri_equivalent_out"] = r.counts_out.tri_equivalent;
-              j["validity"] = {
-                  {"nonmanifold_edges", validity.nonmanifold_edges},
-                  {"nonmanifold_vertices", validity.nonmanifold_vertices},
-                  {"degenerate_faces", validity.degenerate_faces},
-                  {"duplicate_faces", validity.duplicate_faces},
-                  {"zero_length_edges", validity.zero_length_edges},
-                  {"zero_length_edges_in", input_validity.zero_length_edges},
-                  {"boundary_edges", validity.boundary_edges},
-                  {"components", validity.components},
-                  {"new_nonmanifold_edges",
-                   std::max<long>(0, long(validity.nonmanifold_edges) - long(input_validity.nonmanifold_edges))},
-              };
+              j["validity"] = validity_json(validity, input_validity);
               std::printf("%s\n", j.dump(2).c_str());
               return kExitOk;
             }

@@ -34,6 +34,21 @@
 
 namespace quadlod {
 
+namespace eval_detail {
+
+PolyMesh scaled_copy(const PolyMesh& m, const Vec3& centre, double s) {
+  PolyMesh out;
+  out.positions.resize(m.positions.size());
+  for (std::size_t i = 0; i < m.positions.size(); ++i) out.positions[i] = (m.positions[i] - centre) * s;
+  out.face_offsets = m.face_offsets;
+  out.corner_vertex = m.corner_vertex;
+  return out;
+}
+
+}  // namespace eval_detail
+
+using eval_detail::scaled_copy;
+
 using eval_detail::Directed;
 using eval_detail::feature_metrics;
 using eval_detail::kNaN;
@@ -54,15 +69,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// Geometry-only copy in metric units: p ↦ s·(p − centre). Faces are shared verbatim.
-PolyMesh scaled_copy(const PolyMesh& m, const Vec3& centre, double s) {
-  PolyMesh out;
-  out.positions.resize(m.positions.size());
-  for (std::size_t i = 0; i < m.positions.size(); ++i) out.positions[i] = (m.positions[i] - centre) * s;
-  out.face_offsets = m.face_offsets;
-  out.corner_vertex = m.corner_vertex;
-  return out;
-}
 
 /// Vertices used by at least one face, in increasing id order.
 std::vector<Vec3> used_vertices(const PolyMesh& m) {

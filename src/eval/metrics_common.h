@@ -20,6 +20,11 @@
 
 namespace quadlod::eval_detail {
 
+/// Geometry-only copy in metric units: p ↦ s·(p − centre), faces shared verbatim; evaluate()'s
+/// normalisation, also used by the LOD chain's Hausdorff (pipeline/lod_distance.cpp) so both
+/// measure the same numbers.
+PolyMesh scaled_copy(const PolyMesh& m, const Vec3& centre, double s);
+
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Calls fn(begin, end) for the fixed chunks [k·kChunk, min(n, (k+1)·kChunk)) on `threads`

@@ -146,4 +146,18 @@ std::string check_pipeline_input(const PolyMesh& mesh) {
   return {};
 }
 
+nlohmann::json validity_json(const MeshStats& output, const MeshStats& input) {
+  return {
+      {"nonmanifold_edges", output.nonmanifold_edges},
+      {"nonmanifold_vertices", output.nonmanifold_vertices},
+      {"degenerate_faces", output.degenerate_faces},
+      {"duplicate_faces", output.duplicate_faces},
+      {"zero_length_edges", output.zero_length_edges},
+      {"zero_length_edges_in", input.zero_length_edges},
+      {"boundary_edges", output.boundary_edges},
+      {"components", output.components},
+      {"new_nonmanifold_edges", std::max<long>(0, long(output.nonmanifold_edges) - long(input.nonmanifold_edges))},
+  };
+}
+
 }  // namespace quadlod

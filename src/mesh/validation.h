@@ -62,6 +62,10 @@ MeshStats compute_stats(const PolyMesh& mesh, const Connectivity& conn,
 /// JSON object with the keys documented in README.md (`quadlod info --json`).
 nlohmann::json to_json(const MeshStats& stats);
 
+/// The `validity` object of `quadlod eval --json` (and of the Python module's evaluate()): the
+/// output's counts, and the non-manifold edges it adds to the input's.
+nlohmann::json validity_json(const MeshStats& output, const MeshStats& input);
+
 /// Problems a pipeline stage cannot take as input. Empty when the mesh is acceptable.
 /// Reports the first problem, naming the element: "vertex 17 has a non-finite coordinate".
 std::string check_pipeline_input(const PolyMesh& mesh);

@@ -1,6 +1,8 @@
 // quadlod — HausdorffToInput (src/pipeline/lod_distance.h).
 #include "pipeline/lod_distance.h"
 
+#include "eval/metrics_common.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,15 +12,6 @@ namespace quadlod::lod_detail {
 
 namespace {
 
-/// evaluate()'s normalisation, operation for operation: p ↦ (p − c) · s.
-PolyMesh scaled(const PolyMesh& m, const Vec3& centre, double s) {
-  PolyMesh out;
-  out.positions.resize(m.positions.size());
-  for (std::size_t i = 0; i < m.positions.size(); ++i) out.positions[i] = (m.positions[i] - centre) * s;
-  out.face_offsets = m.face_offsets;
-  out.corner_vertex = m.corner_vertex;
-  return out;
-}
 
 /// Interleaves the low 21 bits of x with two zero bits between each (Morton code, one axis).
 std::uint64_t spread_bits(std::uint64_t x) {
@@ -78,7 +71,7 @@ HausdorffToInput::HausdorffToInput(const PolyMesh& input, std::uint64_t samples,
   if (!(side > 0.0)) return;
   scale_ = 1.0 / side;
   centre_ = 0.5 * (box.min + box.max);
-  const PolyMesh in = scaled(input, centre_, scale_);
+  const PolyMesh in = eval_detail::scaled_copy(input, centre_, scale_);
   const TriangleSoup soup = fan_triangulate(in);
   const SurfaceSamples s = sample_triangles(soup, samples_, seed_, 0);
   if (!(s.total_area > 0.0)) return;
@@ -89,7 +82,7 @@ HausdorffToInput::HausdorffToInput(const PolyMesh& input, std::uint64_t samples,
 
 double HausdorffToInput::measure(const PolyMesh& level) const {
   if (!ok_) return std::numeric_limits<double>::quiet_NaN();
-  const PolyMesh out = scaled(level, centre_, scale_);
+  const PolyMesh out = eval_detail::scaled_copy(level, centre_, scale_);
   const TriangleSoup soup = fan_triangulate(out);
   const SurfaceSamples s = sample_triangles(soup, samples_, seed_, 1);
   if (!(s.total_area > 0.0)) return std::numeric_limits<double>::quiet_NaN();
