@@ -13,6 +13,7 @@
 #include "quadlod/skin.h"
 #include "topology/analysis.h"
 #include "util/progress.h"
+#include "util/stage_log.h"
 
 #include <algorithm>
 #include <chrono>
@@ -66,39 +67,6 @@ std::vector<std::uint8_t> feature_pins(const Connectivity& conn, const FeatureEd
   }
   return pins;
 }
-
-// Progress on stderr: one line per finished stage, "[2/5] select  37%  0.01 s  (elapsed
-// 0.41 s)  …". The percentage is the work done — triangle-equivalents removed so far of those the
-// whole reduction removes (issue 20: work, not the time budget); the pipeline sets it after every
-// collapse. A reduction in many passes would print dozens of lines a second, so a line is only
-// printed once at least `min_gap` seconds passed since the last one (the final line always is).
-class StageLog {
- public:
-  explicit StageLog(bool enabled, double min_gap = 0.25) : enabled_(enabled), min_gap_(min_gap) {}
-  /// The reduction runs from `from` to `to` triangle-equivalents; `now` is where it stands.
-  void set_span(double from, double to) {
-    from_ = from;
-    to_ = to;
-  }
-  void set_count(double now) { work_ = from_ > to_ ? std::clamp((from_ - now) / (from_ - to_), 0.0, 1.0) : 1.0; }
-  void done(int index, const char* stage, double seconds, const std::string& detail = {}) {
-    if (!enabled_) return;
-    const double now = total_.seconds();
-    if (index < 5 && printed_ && now - last_ < min_gap_) return;
-    printed_ = true;
-    last_ = now;
-    std::fprintf(stderr, "[%d/5] %-9s %3d%%  %7.2f s  (elapsed %.2f s)%s%s\n", index, stage,
-                 index == 5 ? 100 : int(work_ * 100.0), seconds, now, detail.empty() ? "" : "  ",
-                 detail.c_str());
-  }
-
- private:
-  bool enabled_;
-  double min_gap_;
-  double work_ = 0.0, last_ = 0.0, from_ = 0.0, to_ = 0.0;
-  bool printed_ = false;
-  Stopwatch total_;
-};
 
 nlohmann::json solve_json(const SelectionResult& s) {
   nlohmann::json j = {
