@@ -179,6 +179,7 @@ struct PassOutcome {
   Index refusals = 0;
   bool out_of_reach = false;
   std::uint64_t predicted = 0;
+  bool anything_selected = false;  // some round's selection removed something (before the collapse)
   std::int64_t selection_target = 0;
   Index feature_pins = 0;
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
@@ -309,6 +310,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     }
     const double select_seconds = clock.seconds();
     out.seconds_select += select_seconds;
+    if (selection.predicted < out.input_tri_equivalent) out.anything_selected = true;
     log.done(2, "select", select_seconds,
              "N' " + std::to_string(selection.predicted) + " of " + std::to_string(selection_target) +
                  (selection.solver_ran ? ", solver " + std::string(ilp::to_string(selection.solve.status)) : "") +
@@ -654,6 +656,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                       {"report", outcome.report}});
     const bool improved = pass <= planned || outcome.achieved < last.achieved;
     if (!improved) break;  // an extra pass that does not get closer is dropped
+    // A pass whose selection found nothing to remove (every edge pinned: a mesh of lone quads,
+    // all boundary) leaves its input as it was; the next pass would see the same mesh and find
+    // the same nothing, so the run ends here instead of repeating it for every planned pass.
+    const bool stuck = outcome.achieved == pass_in && !outcome.anything_selected;
     last = std::move(outcome);
     for (Index& f : last.face_source) f = face_origin[f];
     face_origin = std::move(last.face_source);
@@ -665,7 +671,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     if (pass >= planned &&
         std::abs(double(last.achieved) - n) <= options.round_tolerance * n)
       break;
-    if (last.achieved <= result.target) break;
+    if (last.achieved <= result.target || stuck) break;
   }
   for (const char* key : {"analysis", "features", "skin_borders", "selection", "dual_repair", "collapse", "rounds"})
     if (last.report.contains(key)) report[key] = last.report[key];
@@ -710,21 +716,21 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     char text[448];
     if (last.out_of_reach)
       std::snprintf(text, sizeof text,
-                    "achieved %llu is %+.1f %% off the target %llu after %d passes: in the last, the hard "
+                    "achieved %llu is %+.1f %% off the target %llu after %d pass%s: in the last, the hard "
                     "constraints (%u feature-pinned edges, edges of refused collapses) left no selection "
                     "closer than %llu (aimed at %lld) and the collapse refused %u clusters (report: "
                     "features, collapse.refused)",
                     static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
                     static_cast<unsigned long long>(result.target), result.passes_used,
-                    static_cast<unsigned>(last.feature_pins), static_cast<unsigned long long>(last.predicted),
+                    result.passes_used == 1 ? "" : "es", static_cast<unsigned>(last.feature_pins), static_cast<unsigned long long>(last.predicted),
                     static_cast<long long>(last.selection_target), static_cast<unsigned>(last.refusals));
     else
       std::snprintf(text, sizeof text,
-                    "achieved %llu is %+.1f %% off the target %llu after %d passes: the collapse refused "
+                    "achieved %llu is %+.1f %% off the target %llu after %d pass%s: the collapse refused "
                     "%u clusters (report: collapse.refused) whose collapse would break a guarantee",
                     static_cast<unsigned long long>(result.achieved), 100.0 * deviation,
                     static_cast<unsigned long long>(result.target), result.passes_used,
-                    static_cast<unsigned>(last.refusals));
+                    result.passes_used == 1 ? "" : "es", static_cast<unsigned>(last.refusals));
     result.note = std::string(text) + costliest_refusals();
   }
   // UV islands, exactly, from provenance (docs/attributes.md, "Island accounting").
