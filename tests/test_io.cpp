@@ -161,7 +161,10 @@ TEST(ObjRead, NGonsKeepTheirCornersInOrder) {
   for (int i = 0; i < 40; ++i)
     text += "v " + std::to_string(std::cos(i * 0.157)) + " " + std::to_string(std::sin(i * 0.157)) + " 0\n";
   text += "f 1 2 3 4 5\nf 6 7 8 9 10 11\nf";
-  for (int i = 40; i >= 1; --i) text += " " + std::to_string(i);
+  for (int i = 40; i >= 1; --i) {
+    text += ' ';
+    text += std::to_string(i);
+  }
   text += "\n";
   const ReadResult r = obj(text);
   ASSERT_TRUE(r.ok()) << r.error;

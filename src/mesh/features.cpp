@@ -16,6 +16,7 @@
 #include "mesh/features.h"
 
 #include "mesh/union_find.h"
+#include "util/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -87,57 +88,58 @@ FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
   const bool use_smoothing = params.smoothing_groups && !mesh.face_smoothing.empty();
   const bool has_materials = !mesh.face_material.empty();
   const std::size_t uv_sets = std::min<std::size_t>(mesh.uv_sets.size(), 32);
-  // Face normals on demand: only faces next to a manifold edge need one, each at most once.
+  // Face normals of every face, then each edge's bits, on all threads (each item written by one
+  // chunk); the counts below run in edge order, so the result does not depend on the threads.
   std::vector<Vec3> normal(mesh.num_faces());
-  std::vector<char> normal_done(mesh.num_faces(), 0);
-  auto face_n = [&](Index f) -> const Vec3& {
-    if (!normal_done[f]) {
-      normal[f] = face_normal(mesh, f);
-      normal_done[f] = 1;
-    }
-    return normal[f];
-  };
+  parallel_chunks(std::size_t(mesh.num_faces()), params.threads, params.min_parallel_edges, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (Index f = Index(b); f < Index(e); ++f) normal[f] = face_normal(mesh, f);
+  });
 
   // --- classify every edge -------------------------------------------------------------------
-  for (Index e = 0; e < ne; ++e) {
-    const Index count = conn.edge_face_count(e);
-    std::uint8_t bits = 0;
-    std::uint32_t seam_sets = 0;
-    if (count == 1) {
-      bits = kFeatureBoundary;
-    } else if (count > 2) {
-      bits = kFeatureNonManifold;
-    } else {
-      const auto cs = conn.corners_of_edge(e);
-      const Index c0 = cs[0], c1 = cs[1];
-      const Index f0 = conn.corner_face[c0], f1 = conn.corner_face[c1];
-      for (std::size_t k = 0; k < uv_sets; ++k)
-        if (seam_across(conn, mesh.uv_sets[k].values, mesh.uv_sets[k].corner, c0, c1))
-          seam_sets |= std::uint32_t{1} << k;
-      if (seam_sets) bits |= kFeatureUvSeam;
-      if (mesh.has_normals() && seam_across(conn, mesh.normals, mesh.corner_normal, c0, c1))
-        bits |= kFeatureNormalSeam;
-      if (has_materials && !same_material(mesh, f0, f1)) bits |= kFeatureMaterialBorder;
-      // Smoothing groups (OBJ `s`): normals are shared within a group, so an edge between two
-      // groups is a crease. Group 0 (`s off`) is flat shading (Blender imports it as a face with
-      // use_smooth off, not as sharp edges): between a flat and a smooth face the shading breaks,
-      // but between two flat faces it is per face on both sides anyway — no crease line, and
-      // marking it would make every edge of a faceted model a feature. The dihedral rule below
-      // still catches real creases there.
-      if (use_smoothing && mesh.face_smoothing[f0] != mesh.face_smoothing[f1]) bits |= kFeatureHardEdge;
-      // Dihedral angle = angle between the face normals, with the second normal reversed when the
-      // faces are inconsistently oriented (else a flat but flipped pair would read as 180°).
-      // A zero-area face has no normal and never makes a hard edge.
-      const Vec3& n0 = face_n(f0);
-      const Vec3& n1 = face_n(f1);
-      if (!n0.isZero(0.0) && !n1.isZero(0.0)) {
-        if (angle_deg(n0, same_direction(conn, c0, c1) ? Vec3(-n1) : n1) >= params.hard_angle_deg) bits |= kFeatureHardEdge;
+  parallel_chunks(std::size_t(ne), params.threads, params.min_parallel_edges, [&](std::size_t begin, std::size_t end, std::size_t) {
+    for (Index e = Index(begin); e < Index(end); ++e) {
+      const Index count = conn.edge_face_count(e);
+      std::uint8_t bits = 0;
+      std::uint32_t seam_sets = 0;
+      if (count == 1) {
+        bits = kFeatureBoundary;
+      } else if (count > 2) {
+        bits = kFeatureNonManifold;
+      } else {
+        const auto cs = conn.corners_of_edge(e);
+        const Index c0 = cs[0], c1 = cs[1];
+        const Index f0 = conn.corner_face[c0], f1 = conn.corner_face[c1];
+        for (std::size_t k = 0; k < uv_sets; ++k)
+          if (seam_across(conn, mesh.uv_sets[k].values, mesh.uv_sets[k].corner, c0, c1))
+            seam_sets |= std::uint32_t{1} << k;
+        if (seam_sets) bits |= kFeatureUvSeam;
+        if (mesh.has_normals() && seam_across(conn, mesh.normals, mesh.corner_normal, c0, c1))
+          bits |= kFeatureNormalSeam;
+        if (has_materials && !same_material(mesh, f0, f1)) bits |= kFeatureMaterialBorder;
+        // Smoothing groups (OBJ `s`): normals are shared within a group, so an edge between two
+        // groups is a crease. Group 0 (`s off`) is flat shading (Blender imports it as a face with
+        // use_smooth off, not as sharp edges): between a flat and a smooth face the shading breaks,
+        // but between two flat faces it is per face on both sides anyway — no crease line, and
+        // marking it would make every edge of a faceted model a feature. The dihedral rule below
+        // still catches real creases there.
+        if (use_smoothing && mesh.face_smoothing[f0] != mesh.face_smoothing[f1]) bits |= kFeatureHardEdge;
+        // Dihedral angle = angle between the face normals, with the second normal reversed when the
+        // faces are inconsistently oriented (else a flat but flipped pair would read as 180°).
+        // A zero-area face has no normal and never makes a hard edge.
+        const Vec3& n0 = normal[f0];
+        const Vec3& n1 = normal[f1];
+        if (!n0.isZero(0.0) && !n1.isZero(0.0)) {
+          if (angle_deg(n0, same_direction(conn, c0, c1) ? Vec3(-n1) : n1) >= params.hard_angle_deg) bits |= kFeatureHardEdge;
+        }
       }
+      bits &= params.enabled;
+      if (!(bits & kFeatureUvSeam)) seam_sets = 0;
+      fe.edge_bits[e] = bits;
+      fe.edge_uv_seam_sets[e] = seam_sets;
     }
-    bits &= params.enabled;
-    if (!(bits & kFeatureUvSeam)) seam_sets = 0;
-    fe.edge_bits[e] = bits;
-    fe.edge_uv_seam_sets[e] = seam_sets;
+  });
+  for (Index e = 0; e < ne; ++e) {
+    const std::uint8_t bits = fe.edge_bits[e];
     if (!bits) continue;
     ++fe.feature_edges;
     for (int b = 0; b < 6; ++b)

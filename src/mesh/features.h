@@ -72,6 +72,10 @@ struct FeatureParams {
   /// its seams are placement seams, not strict ones. Corpus: 1.00 on the two cages, at most 0.06
   /// on every other mesh (docs/attributes.md).
   double per_face_layout_fraction = 0.5;
+  /// Threads for the per-edge classification (0 = every core); only the speed depends on them.
+  /// Below min_parallel_edges edges it runs on one thread (a thread costs more than it saves).
+  int threads = 1;
+  std::size_t min_parallel_edges = 20000;
 };
 
 struct FeatureEdges {

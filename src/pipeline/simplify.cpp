@@ -230,7 +230,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ClusterCollapseParams pass_cp = cp;
   // The vertex quadrics of this pass's input, once for the shape selection and every collapse
   // round (geometry/cluster_quadric.h: the placement both use).
-  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement);
+  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement, options.threads);
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
   if (options.features) {
@@ -562,6 +562,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   cp.respect_features = options.features;
   cp.project_attributes = options.features;
   cp.features.hard_angle_deg = options.hard_angle_deg;
+  cp.features.threads = options.threads;
   cp.place_on_hard_edges = options.place_on_hard_edges;
   // Islands big enough for one output face must keep one (issue 7): the smallest area an output
   // face can have on average, the input's area over the target's tri-equivalents.

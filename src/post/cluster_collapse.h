@@ -79,8 +79,10 @@ struct ClusterCollapseParams {
   /// selection and every collapse round of that pass.
   const VertexQuadrics* vertex_quadrics = nullptr;
   /// Threads of the face checks of a round (each dirty face checked alone; the refusals are
-  /// replayed in face order, so the output does not depend on the count); 0 = all cores. A round
-  /// with fewer than min_parallel_faces dirty faces runs on one thread.
+  /// replayed in face order, so the output does not depend on the count) and of the attribute
+  /// projection (clusters in chunks, their new values appended in chunk order); 0 = all cores. A
+  /// round with fewer than min_parallel_faces dirty faces (a mesh with fewer vertices, for the
+  /// projection) runs on one thread.
   int threads = 0;
   std::size_t min_parallel_faces = 20000;
 

@@ -4,8 +4,10 @@
 #include "geometry/bvh.h"
 #include "mesh/union_find.h"
 #include "post/collapser.h"
+#include "util/parallel.h"
 
 #include <algorithm>
+#include <mutex>
 #include <cmath>
 
 namespace quadlod::collapse_detail {
@@ -160,11 +162,24 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
     Index c0 = kInvalidIndex, c1 = kInvalidIndex, c2 = kInvalidIndex;  // input corners
     Vec3 w = Vec3::Zero();                                             // barycentric weights
   };
+  // Clusters in contiguous chunks of roots on all threads. Each chunk writes the overrides of
+  // its own clusters' corners and appends its new values to its own lists, numbered from 0;
+  // the lists are then appended in chunk order and the chunk's overrides shifted by what came
+  // before, so the output is the same for any thread count.
+  struct NewValues {
+    std::vector<std::vector<Vec2>> uv;
+    std::vector<Vec3> normals;
+  };
+  std::vector<NewValues> fresh;
+  std::mutex fresh_mutex;
+  const std::size_t chunks = parallel_chunks(std::size_t(nv_), params_.threads, params_.min_parallel_faces,
+                                             [&](std::size_t chunk_begin, std::size_t chunk_end, std::size_t chunk) {
+  NewValues mine;
+  mine.uv.resize(sets);
   std::vector<Index> star, star_slot(nf_, kInvalidIndex), sector(0);
   std::vector<Nearest> nearest;
   std::vector<Index> sector_value;
-  std::vector<Vec3> sector_normal;
-  for (Index r = 0; r < nv_; ++r) {
+  for (Index r = Index(chunk_begin); r < Index(chunk_end); ++r) {
     if (root_[r] != r || cluster_size(r) < 2) continue;
     star.clear();
     for (Index m : members(r))
@@ -258,9 +273,8 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
         if (!best) return kInvalidIndex;
         const Vec2 uv = best->w[0] * set.values[set.corner[best->c0]] + best->w[1] * set.values[set.corner[best->c1]] +
                         best->w[2] * set.values[set.corner[best->c2]];
-        om.uv_sets[k].values.push_back(uv);
-        ++stats_.uv_values_projected;
-        return static_cast<Index>(om.uv_sets[k].values.size() - 1);
+        mine.uv[k].push_back(uv);
+        return static_cast<Index>(mine.uv[k].size() - 1);
       });
     }
     if (normals) {
@@ -281,12 +295,40 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
         }
         const double n = sum.norm();
         if (!(n > 0.0) || !std::isfinite(n)) return kInvalidIndex;
-        om.normals.push_back(sum / n);
-        ++stats_.normals_recomputed;
-        return static_cast<Index>(om.normals.size() - 1);
+        mine.normals.push_back(sum / n);
+        return static_cast<Index>(mine.normals.size() - 1);
       });
     }
     for (Index f : star) star_slot[f] = kInvalidIndex;
+  }
+  std::lock_guard lock(fresh_mutex);
+  if (fresh.size() <= chunk) fresh.resize(chunk + 1);
+  fresh[chunk] = std::move(mine);
+  });
+
+  const std::size_t per_chunk = (std::size_t(nv_) + chunks - 1) / std::max<std::size_t>(1, chunks);
+  for (std::size_t chunk = 0; chunk < fresh.size(); ++chunk) {
+    NewValues& mine = fresh[chunk];
+    std::vector<Index> uv_base(sets);
+    for (std::size_t k = 0; k < sets; ++k) {
+      uv_base[k] = static_cast<Index>(om.uv_sets[k].values.size());
+      om.uv_sets[k].values.insert(om.uv_sets[k].values.end(), mine.uv[k].begin(), mine.uv[k].end());
+      stats_.uv_values_projected += static_cast<Index>(mine.uv[k].size());
+    }
+    const Index normal_base = static_cast<Index>(om.normals.size());
+    om.normals.insert(om.normals.end(), mine.normals.begin(), mine.normals.end());
+    stats_.normals_recomputed += static_cast<Index>(mine.normals.size());
+    const Index begin = Index(std::min(std::size_t(nv_), chunk * per_chunk));
+    const Index end = Index(std::min(std::size_t(nv_), (chunk + 1) * per_chunk));
+    for (Index r = begin; r < end; ++r) {
+      if (root_[r] != r || cluster_size(r) < 2) continue;
+      for (Index m : members(r))
+        for (Index c : conn_.corners_at_vertex(m)) {
+          for (std::size_t k = 0; k < sets; ++k)
+            if (uv_override[k][c] != kInvalidIndex) uv_override[k][c] += uv_base[k];
+          if (normals && normal_override[c] != kInvalidIndex) normal_override[c] += normal_base;
+        }
+    }
   }
 }
 

@@ -117,28 +117,36 @@ class ShapeState {
   ShapeState(const PolyMesh& mesh, const Connectivity& conn, const ShapeSelectionParams& params)
       : mesh_(mesh), conn_(conn), params_(params), uf_(mesh.num_vertices()) {
     const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
-    if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement);
+    if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement, params.threads);
     quadrics_ = params.vertex_quadrics ? params.vertex_quadrics : &own_quadrics_;
     h_ = quadrics_->mean_edge;
+    // Per-vertex and per-face set-up on all threads: every item is written by one chunk and the
+    // sums below run in item order, so the state is the same for any thread count.
     terms_.resize(nv);
-    for (Index v = 0; v < nv; ++v) terms_[v] = vertex_alone(v);
+    parallel_chunks(std::size_t(nv), params.threads, params.min_parallel_candidates, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t v = b; v < e; ++v) terms_[v] = vertex_alone(Index(v));
+    });
     err_.assign(nv, 0.0);  // a lone vertex sits on all of its planes
     pos_ = mesh.positions;
     next_member_.resize(nv);
     std::iota(next_member_.begin(), next_member_.end(), Index{0});  // circular member lists
     kept_.assign(conn.num_edges, 1);
-    face_kept_.assign(nf, 0);
-    log_aspect0_.assign(nf, 0.0);
+    face_kept_.resize(nf);
+    log_aspect0_.resize(nf);
     pen_.assign(nf, 0.0);
+    face_n0_.resize(nf);
+    std::vector<double> face_area(nf);
+    parallel_chunks(std::size_t(nf), params.threads, params.min_parallel_candidates, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (Index f = Index(b); f < Index(e); ++f) {
+        face_kept_[f] = mesh.face_size(f);
+        const Vec3 av = face_area_vector(mesh, f);
+        face_area[f] = av.norm();
+        face_n0_[f] = face_area[f] > 0.0 ? Vec3(av / face_area[f]) : Vec3::Zero();
+        log_aspect0_[f] = mesh.face_size(f) == 4 ? log_aspect(f, [&](Index v) -> const Vec3& { return mesh.positions[v]; }) : 0.0;
+      }
+    });
     double area = 0.0;
-    face_n0_.assign(nf, Vec3::Zero());
-    for (Index f = 0; f < nf; ++f) {
-      face_kept_[f] = mesh.face_size(f);
-      const Vec3 av = face_area_vector(mesh, f);
-      area += av.norm();
-      if (av.norm() > 0.0) face_n0_[f] = av / av.norm();
-      if (mesh.face_size(f) == 4) log_aspect0_[f] = log_aspect(f, [&](Index v) -> const Vec3& { return mesh.positions[v]; });
-    }
+    for (Index f = 0; f < nf; ++f) area += face_area[f];
     const double diag = bounding_box(mesh).diagonal();
     cos_flip_ = std::cos(std::clamp(params.flip_angle_deg, 1e-6, 180.0) * std::numbers::pi / 180.0);
     min_area2_ = 2.0 * std::max(0.0, params.zero_area_epsilon) * diag * diag;
