@@ -90,7 +90,19 @@ struct Scratch {
   Index token = 0, face_tok2 = 0;
   std::vector<Index> root_token, root_local, face_token, face_removed, face_token2;
   std::vector<Index> locals, local_parent, set_of, moved_edges, touched_faces, shape_faces;
+  // The clusters of the current pricing are sets[0, live): the entries are reused, so their
+  // member lists keep their capacity and a pricing allocates nothing once warm.
   std::vector<NewCluster> sets;
+  std::size_t live = 0;
+  std::span<NewCluster> live_sets() { return {sets.data(), live}; }
+  std::span<const NewCluster> live_sets() const { return {sets.data(), live}; }
+  NewCluster& add_set() {
+    if (live == sets.size()) sets.emplace_back();
+    NewCluster& s = sets[live++];
+    s.terms = ClusterTerms{};
+    s.roots.clear();
+    return s;
+  }
 
   Index local_of(Index root) {
     if (root_token[root] != token) {
@@ -186,19 +198,19 @@ class ShapeState {
 
     // New clusters: the sums of their old clusters' terms, placed.
     sc.set_of.assign(sc.locals.size(), kInvalidIndex);
-    sc.sets.clear();
+    sc.live = 0;
     for (std::size_t i = 0; i < sc.locals.size(); ++i) {
       const Index r = sc.find_local(Index(i));
       if (sc.set_of[r] == kInvalidIndex) {
-        sc.set_of[r] = Index(sc.sets.size());
-        sc.sets.push_back({});
+        sc.set_of[r] = Index(sc.live);
+        sc.add_set();
       }
       NewCluster& s = sc.sets[sc.set_of[r]];
       s.terms += terms_[sc.locals[i]];
       s.roots.push_back(sc.locals[i]);
       m.error -= err_[sc.locals[i]];
     }
-    for (NewCluster& s : sc.sets) {
+    for (NewCluster& s : sc.live_sets()) {
       s.placement = place_cluster(s.terms, h_, params_.placement, [&](auto&& visit) {
         for (Index r : s.roots) for_each_member(r, [&](Index v) { visit(mesh_.positions[v]); });
       });
@@ -226,7 +238,7 @@ class ShapeState {
     // Faces with a corner in a merged cluster (their corners move): validity and quad shapes.
     if (params_.check_faces || params_.lambda_shape > 0.0) {
       gather_faces(sc, [&](auto&& visit) {
-        for (const NewCluster& s : sc.sets)
+        for (const NewCluster& s : sc.live_sets())
           for (Index r : s.roots) for_each_member(r, visit);
       });
       for (Index f : sc.shape_faces) {
@@ -334,7 +346,7 @@ class ShapeState {
     for (Index f : sc.touched_faces) face_kept_[f] -= sc.face_removed[f];
     count_ -= m.reduced;
     error_ += m.error;
-    for (const NewCluster& s : sc.sets) {
+    for (const NewCluster& s : sc.live_sets()) {
       Index root = s.roots[0];
       for (std::size_t i = 1; i < s.roots.size(); ++i) {
         const Index joined = uf_.unite(root, s.roots[i]);
