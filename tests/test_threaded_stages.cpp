@@ -8,6 +8,8 @@
 #include "quadlod/generators.h"
 #include "quadlod/io.h"
 #include "quadlod/simplify.h"
+#include "topology/polychords.h"
+#include "topology/segmentation.h"
 
 #include <gtest/gtest.h>
 
@@ -170,6 +172,33 @@ TEST(ThreadedStages, FeatureEdgesDoNotDependOnThreads) {
     EXPECT_EQ(fe.vertex_corner, ref.vertex_corner);
     EXPECT_EQ(fe.edge_line, ref.edge_line);
     EXPECT_EQ(fe.edges_with_bit, ref.edges_with_bit);
+  }
+}
+
+TEST(ThreadedStages, SegmentsDoNotDependOnThreads) {
+  const PolyMesh cube = make_cube(60);  // 21 600 quads; every chord turns at the cube's edges
+  const Connectivity conn = build_connectivity(cube);
+  const PolyChordResult chords = extract_polychords(cube, conn);
+  const SegmentationResult ref = segment_polychords(cube, conn, chords);
+  ASSERT_GT(ref.stats.num_dihedral, 0u);
+  for (int threads : {2, 3}) {
+    SegmentationParams p;
+    p.threads = threads;
+    const SegmentationResult r = segment_polychords(cube, conn, chords, p);
+    ASSERT_EQ(r.segments.size(), ref.segments.size());
+    for (std::size_t i = 0; i < r.segments.size(); ++i) {
+      EXPECT_EQ(r.segments[i].chord, ref.segments[i].chord);
+      EXPECT_EQ(r.segments[i].opposing_edges, ref.segments[i].opposing_edges);
+    }
+    EXPECT_EQ(r.edge_segment, ref.edge_segment);
+    EXPECT_EQ(r.chord_segment_begin, ref.chord_segment_begin);
+    ASSERT_EQ(r.breakpoints.size(), ref.breakpoints.size());
+    for (std::size_t i = 0; i < r.breakpoints.size(); ++i) {
+      EXPECT_EQ(r.breakpoints[i].edge, ref.breakpoints[i].edge);
+      EXPECT_EQ(r.breakpoints[i].reasons, ref.breakpoints[i].reasons);
+    }
+    EXPECT_EQ(r.stats.num_breakpoints, ref.stats.num_breakpoints);
+    EXPECT_EQ(r.stats.num_degenerate_skipped, ref.stats.num_degenerate_skipped);
   }
 }
 

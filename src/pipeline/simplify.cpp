@@ -200,6 +200,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   AnalysisParams ap;
   ap.segmentation.enable = options.segmentation;
   ap.segmentation.epsilon_theta = options.epsilon_theta_deg * std::numbers::pi / 180.0;
+  ap.segmentation.threads = options.threads;
   ap.clusters = options.objective == "paper";
   const AnalysisResult analysis = analyze(input, conn, ap);
   out.seconds_analysis = clock.seconds();

@@ -18,6 +18,8 @@
 // self-intersection breakpoints.
 #include "topology/segmentation.h"
 
+#include "util/parallel.h"
+
 #include <cmath>
 
 namespace quadlod {
@@ -39,14 +41,14 @@ struct ChordSegmenter {
 
   std::vector<std::uint8_t> reasons;  // per position of the current chord
 
-  void run(Index chord_id, const PolyChord& chord) {
+  // `geometric_reasons`: what geometric(chord) found for this chord (computed beforehand, on
+  // any thread).
+  void run(Index chord_id, const PolyChord& chord, std::vector<std::uint8_t>&& geometric_reasons) {
     const Index m = chord.size();
     const Index num_edges = static_cast<Index>(chord.opposing_edges.size());
-    reasons.assign(num_edges, 0);
-    if (params.enable && m > 0) {
-      if (params.use_dihedral || params.use_binormal) geometric(chord);
-      if (params.use_self_intersection) self_intersection(chord_id, chord);
-    }
+    reasons = std::move(geometric_reasons);
+    reasons.resize(num_edges, 0);
+    if (params.enable && m > 0 && params.use_self_intersection) self_intersection(chord_id, chord);
 
     // Breakpoint positions; position 0 of an open chord is its start anyway.
     std::vector<Index> starts;
@@ -88,7 +90,11 @@ struct ChordSegmenter {
     }
   }
 
-  void geometric(const PolyChord& chord) {
+  // The dihedral and bi-normal breakpoints of one chord into `reasons` (one per opposing edge);
+  // reads the mesh only, so chords run on any thread. Returns the tests skipped as degenerate.
+  static Index geometric(const PolyMesh& mesh, const Connectivity& conn, const SegmentationParams& params,
+                         const PolyChord& chord, std::vector<std::uint8_t>& reasons) {
+    Index skipped = 0;
     const Index m = chord.size();
     bool wrap_flip = false;
     const std::vector<Vec3> normals = chord_quad_normals(mesh, conn, chord, &wrap_flip);
@@ -107,15 +113,16 @@ struct ChordSegmenter {
       const double s = (i == 0 && wrap_flip) ? -1.0 : 1.0;
       if (params.use_dihedral) {
         const double a = angle_between(normals[prev], s * normals[i]);
-        if (a < 0.0) ++out.stats.num_degenerate_skipped;
+        if (a < 0.0) ++skipped;
         else if (a > eps) reasons[i] |= kBreakDihedral;
       }
       if (params.use_binormal) {
         const double a = angle_between(binormals[prev], s * binormals[i]);
-        if (a < 0.0) ++out.stats.num_degenerate_skipped;
+        if (a < 0.0) ++skipped;
         else if (a > eps) reasons[i] |= kBreakBinormal;
       }
     }
+    return skipped;
   }
 
   void self_intersection(Index chord_id, const PolyChord& chord) {
@@ -159,11 +166,28 @@ SegmentationResult segment_polychords(const PolyMesh& mesh, const Connectivity& 
   SegmentationResult out;
   out.edge_segment.assign(conn.num_edges, kInvalidIndex);
   out.chord_segment_begin.reserve(chords.chords.size() + 1);
+  // The geometric tests (the cost: normals, medial points and angles of every chord position)
+  // on all threads, each chord alone; the segments are then cut chord by chord in order.
+  const std::size_t nc = chords.chords.size();
+  std::vector<std::vector<std::uint8_t>> geometric(nc);
+  std::vector<Index> skipped(nc, 0);
+  const bool test_geometry = params.enable && (params.use_dihedral || params.use_binormal);
+  if (test_geometry)
+    parallel_chunks(nc, params.threads, conn.num_edges < params.min_parallel_edges ? nc + 1 : 0,
+                    [&](std::size_t begin, std::size_t end, std::size_t) {
+                      for (std::size_t c = begin; c < end; ++c) {
+                        const PolyChord& chord = chords.chords[c];
+                        geometric[c].assign(chord.opposing_edges.size(), 0);
+                        if (chord.size() > 0)
+                          skipped[c] = ChordSegmenter::geometric(mesh, conn, params, chord, geometric[c]);
+                      }
+                    });
   ChordSegmenter seg{mesh, conn, params, out, std::vector<Index>(conn.num_vertices, 0), {}};
   seg.edge_chord = &chords.edge_chord;
-  for (Index c = 0; c < chords.chords.size(); ++c) {
+  for (Index c = 0; c < nc; ++c) {
     out.chord_segment_begin.push_back(static_cast<Index>(out.segments.size()));
-    seg.run(c, chords.chords[c]);
+    out.stats.num_degenerate_skipped += skipped[c];
+    seg.run(c, chords.chords[c], std::move(geometric[c]));
   }
   out.chord_segment_begin.push_back(static_cast<Index>(out.segments.size()));
   return out;

@@ -54,6 +54,10 @@ struct SegmentationParams {
   bool use_dihedral = true;
   bool use_binormal = true;
   bool use_self_intersection = true;
+  /// Threads for the chords' geometric tests (0 = every core); the segments do not depend on
+  /// them. A mesh with fewer than min_parallel_edges edges is segmented on one thread.
+  int threads = 1;
+  std::size_t min_parallel_edges = 20000;
 };
 
 /// Breakpoint reasons, a bit set (one edge may have several).
