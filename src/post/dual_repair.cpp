@@ -26,19 +26,35 @@ Clusters make_clusters(const Connectivity& conn, const std::vector<std::uint8_t>
   Clusters c(conn.num_vertices);
   for (Index e = 0; e < conn.num_edges; ++e)
     if (!kept[e]) c.uf.unite(conn.edge_vertices[e][0], conn.edge_vertices[e][1]);
-  std::vector<std::pair<Index, Index>> links;
-  for (Index e = 0; e < conn.num_edges; ++e) {
-    if (!kept[e]) continue;
-    const Index a = c.uf.find(conn.edge_vertices[e][0]), b = c.uf.find(conn.edge_vertices[e][1]);
-    if (a == b) continue;  // a kept edge inside a cluster degenerates; it bounds nothing
-    links.emplace_back(std::min(a, b), std::max(a, b));
-  }
-  std::sort(links.begin(), links.end());
-  links.erase(std::unique(links.begin(), links.end()), links.end());
-  for (const auto& [a, b] : links) {
-    ++c.valence[a];
-    ++c.valence[b];
-  }
+  // Distinct cluster pairs, linearly: the links bucketed by their smaller root, and a stamp per
+  // larger root saying which bucket last counted it (a sort of all links was 2.5 % of a 250k-face
+  // reduction).
+  const Index nv = conn.num_vertices;
+  std::vector<Index> offsets(std::size_t(nv) + 1, 0), stamp(nv, kInvalidIndex);
+  auto link_of = [&](Index e, Index& a, Index& b) {
+    if (kept[e]) {
+      a = c.uf.find(conn.edge_vertices[e][0]);
+      b = c.uf.find(conn.edge_vertices[e][1]);
+      if (a > b) std::swap(a, b);
+      return a != b;  // a kept edge inside a cluster degenerates; it bounds nothing
+    }
+    return false;
+  };
+  Index a = 0, b = 0;
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (link_of(e, a, b)) ++offsets[a + 1];
+  for (Index v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
+  std::vector<Index> larger(offsets[nv]), fill(offsets.begin(), offsets.end() - 1);
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (link_of(e, a, b)) larger[fill[a]++] = b;
+  for (Index lo = 0; lo < nv; ++lo)
+    for (Index i = offsets[lo]; i < offsets[lo + 1]; ++i) {
+      const Index hi = larger[i];
+      if (stamp[hi] == lo) continue;
+      stamp[hi] = lo;
+      ++c.valence[lo];
+      ++c.valence[hi];
+    }
   return c;
 }
 
