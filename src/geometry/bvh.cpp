@@ -8,10 +8,17 @@
 //   * I. Wald, "On fast construction of SAH-based bounding volume hierarchies" (2007): binned SAH.
 #include "geometry/bvh.h"
 
+#include "util/parallel.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace quadlod {
+
+namespace {
+// Below this many primitives the set-up runs on one thread (a thread costs more than it saves).
+constexpr std::size_t kMinParallelPrimitives = 20000;
+}  // namespace
 
 // --- primitive distances -----------------------------------------------------------------------
 
@@ -269,21 +276,25 @@ void Bvh::build(std::span<const Vec3> lo, std::span<const Vec3> hi, std::span<co
 TriangleBvh::TriangleBvh(std::span<const std::array<Vec3, 3>> triangles, const BvhBuildParams& params) {
   const std::size_t n = triangles.size();
   std::vector<Vec3> lo(n), hi(n), ce(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& t = triangles[i];
-    lo[i] = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
-    hi[i] = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
-    ce[i] = 0.5 * (lo[i] + hi[i]);
-  }
+  parallel_chunks(n, params.threads, kMinParallelPrimitives, [&](std::size_t begin, std::size_t end, std::size_t) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto& t = triangles[i];
+      lo[i] = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+      hi[i] = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+      ce[i] = 0.5 * (lo[i] + hi[i]);
+    }
+  });
   bvh_.build(lo, hi, ce, params);
   ids_ = bvh_.order();
   frames_.resize(n);
   pos_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& t = triangles[ids_[i]];
-    frames_[i] = make_triangle_frame(t[0], t[1], t[2]);
-    pos_[ids_[i]] = static_cast<Index>(i);
-  }
+  parallel_chunks(n, params.threads, kMinParallelPrimitives, [&](std::size_t begin, std::size_t end, std::size_t) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto& t = triangles[ids_[i]];
+      frames_[i] = make_triangle_frame(t[0], t[1], t[2]);
+      pos_[ids_[i]] = static_cast<Index>(i);
+    }
+  });
 }
 
 NearestHit TriangleBvh::nearest(const Vec3& p, Index hint) const {

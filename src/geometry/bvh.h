@@ -96,6 +96,9 @@ struct BvhNode {
 struct BvhBuildParams {
   Index max_leaf_size = 4;  ///< leaves hold at most this many primitives (>= 1)
   Index sah_bins = 16;      ///< SAH candidate planes per axis = bins - 1
+  /// Threads for the per-primitive set-up (boxes, triangle frames); 0 = every core. The tree is
+  /// built on one thread and is the same for any count.
+  int threads = 1;
 };
 
 class Bvh {

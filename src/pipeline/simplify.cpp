@@ -596,7 +596,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   // Every pass checks orientation against the original input surface (docs/metrics.md §6b) ...
   std::optional<SurfaceReference> surface;
   if (cp.check_surface_orientation) {
-    surface = make_surface_reference(input);
+    surface = make_surface_reference(input, options.threads);
     cp.surface_reference = &*surface;
   }
   // ... and measures feature_tolerance against the original input's strict lines.

@@ -527,7 +527,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
 
 using collapse_detail::Collapser;
 
-SurfaceReference make_surface_reference(const PolyMesh& mesh) {
+SurfaceReference make_surface_reference(const PolyMesh& mesh, int threads) {
   SurfaceReference ref;
   TriangleSoup soup = fan_triangulate(mesh);
   ref.normal.resize(soup.triangles.size());
@@ -537,7 +537,9 @@ SurfaceReference make_surface_reference(const PolyMesh& mesh) {
     const double len = n.norm();
     ref.normal[t] = len > 0.0 && std::isfinite(len) ? Vec3(n / len) : Vec3::Zero();
   }
-  ref.bvh = TriangleBvh(soup.triangles);
+  BvhBuildParams bvh_params;
+  bvh_params.threads = threads;
+  ref.bvh = TriangleBvh(soup.triangles, bvh_params);
   const double side = bounding_box(mesh).longest_side();
   ref.longest_side = side > 0.0 && std::isfinite(side) ? side : 1.0;
   return ref;

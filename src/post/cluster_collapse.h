@@ -69,7 +69,8 @@ struct SurfaceReference {
   std::vector<Vec3> normal;  ///< unit normal of each triangle of bvh (zero for zero area)
   double longest_side = 1.0;  ///< of the input's bounding box (eval's unit of length)
 };
-SurfaceReference make_surface_reference(const PolyMesh& mesh);
+/// `threads` (0 = every core) changes only the speed.
+SurfaceReference make_surface_reference(const PolyMesh& mesh, int threads = 1);
 
 struct ClusterCollapseParams {
   // --- placement: the cluster quadric (geometry/cluster_quadric.h) -------------------------
