@@ -109,14 +109,13 @@ struct VertexQuadrics {
 };
 
 /// Builds the terms of every vertex of `mesh`. `face_normal` / `face_area` are the unit normal
-/// (zero when the face has no area) and area of every face; `mean_edge` is h. `threads` (0 =
-/// every core) changes only the speed: the terms are the same bits for any count.
+/// (zero when the face has no area) and area of every face; `mean_edge` is h.
 VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn, const std::vector<Vec3>& face_normal,
                                      const std::vector<double>& face_area, double mean_edge,
-                                     const QuadricPlacementParams& params, int threads = 1);
+                                     const QuadricPlacementParams& params);
 /// The same, computing normals, areas and h itself.
 VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn,
-                                     const QuadricPlacementParams& params, int threads = 1);
+                                     const QuadricPlacementParams& params);
 
 struct ClusterPlacement {
   Vec3 position = Vec3::Zero();

@@ -231,7 +231,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ClusterCollapseParams pass_cp = cp;
   // The vertex quadrics of this pass's input, once for the shape selection and every collapse
   // round (geometry/cluster_quadric.h: the placement both use).
-  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement, options.threads);
+  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement);
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
   if (options.features) {

@@ -114,7 +114,7 @@ void Collapser::build_vertex_terms() {
     terms_ = &params_.vertex_quadrics->terms;
     return;
   }
-  own_quadrics_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement, params_.threads);
+  own_quadrics_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement);
   terms_ = &own_quadrics_.terms;
 }
 

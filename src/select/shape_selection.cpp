@@ -129,7 +129,7 @@ class ShapeState {
   ShapeState(const PolyMesh& mesh, const Connectivity& conn, const ShapeSelectionParams& params)
       : mesh_(mesh), conn_(conn), params_(params), uf_(mesh.num_vertices()) {
     const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
-    if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement, params.threads);
+    if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement);
     quadrics_ = params.vertex_quadrics ? params.vertex_quadrics : &own_quadrics_;
     h_ = quadrics_->mean_edge;
     // Per-vertex and per-face set-up on all threads: every item is written by one chunk and the
