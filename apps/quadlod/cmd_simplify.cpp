@@ -25,7 +25,7 @@ struct SimplifyCliOptions {
   std::string formulation = "fast";
   std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
-  bool no_features = false, no_greedy_fallback = false;
+  bool no_features = false, no_greedy_fallback = false, decide_on_doubles = false;
   bool per_mesh = false;
   std::string rig, glb;  // issue 24: skinned input / skinned .glb output
   std::string skin_border_bones = "any";
@@ -127,6 +127,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-greedy-fallback", opt->no_greedy_fallback,
                 "Keep the optimised selection's output even when a greedy selection's run gets closer to the target")
       ->group("Guarantees");
+  sub->add_flag("--decide-on-doubles", opt->decide_on_doubles,
+                "Decide on the coordinates as read, not rounded to float32 (then an OBJ and its FBX may reduce differently)")
+      ->group("Guarantees");
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
@@ -199,6 +202,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.geometry = !opt->no_geometry;
             p.dual_repair = !opt->no_dual;
             p.greedy_fallback = !opt->no_greedy_fallback;
+            p.float32_decisions = !opt->decide_on_doubles;
             p.features = !opt->no_features;
             p.progress = !global.quiet;
             // Skinned meshes (issue 24) take their own path: --rig / --glb, or a skinned glTF input

@@ -6,6 +6,7 @@
 #include "mesh/features.h"
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
+#include "pipeline/storage_precision.h"
 #include "post/dual_repair.h"
 #include "select/selection.h"
 #include "select/shape_selection.h"
@@ -817,7 +818,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
 // the greedy run at +0.5 %, amelia −3.5 % / −0.5 %, yofrankie_ram +19 % / +8.5 %, the crane
 // +26 % / +15 %, with QPR, Chamfer and Hausdorff of the same order (docs/formulation.md,
 // "Rounds against refused collapses").
-SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& options) {
   Stopwatch total;
   SimplifyResult optimised = simplify_once(input, options);
   auto miss = [](const SimplifyResult& r) {
@@ -856,6 +857,20 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (options.progress)
     std::fprintf(stderr, "simplify: %s; kept the %s one\n", text, keep_greedy ? "greedy" : "optimised");
   return std::move(kept);
+}
+
+// Decisions on float32 positions, so that a mesh reduces the same from an OBJ as from its FBX or
+// glTF (src/pipeline/storage_precision.h); the vertices that did not move keep the input's own
+// coordinates.
+SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+  if (!options.float32_decisions) return simplify_on(input, options);
+  std::optional<PolyMesh> rounded = with_float32_positions(input);
+  if (!rounded) return simplify_on(input, options);
+  SimplifyResult result = simplify_on(*rounded, options);
+  rounded.reset();
+  if (result.ok()) restore_input_positions(input, result.mesh);
+  result.report["float32_decisions"] = true;  // the positions were rounded for the decisions
+  return result;
 }
 
 }  // namespace quadlod
