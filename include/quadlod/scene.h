@@ -57,6 +57,11 @@ struct Scene {
   /// line primitives); informational, for `quadlod info`-style summaries and for tests.
   Index cameras = 0, lights = 0, animations = 0;
   std::uint64_t dropped_primitives = 0;  ///< points / lines / faces with < 3 distinct corners
+  /// Binary FBX: how many meshes took their vertices from the file's control points (the exact
+  /// vertices and float64 positions; src/io/fbx_control_points.h) instead of gluing corners, and
+  /// when some did not, why (one line; empty otherwise).
+  Index fbx_control_point_meshes = 0;
+  std::string fbx_note;
   /// Skeleton and animations (issue 24): the joints are the nodes the meshes' bones name (plus
   /// the nodes between them), with their hierarchy, local transforms as rest pose and the bones'
   /// offset matrices as inverse bind matrices; animation channels on joints, times in seconds.
