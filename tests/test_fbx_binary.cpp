@@ -267,3 +267,23 @@ TEST(FbxControlPoints, BlenderExportOfTwoTouchingPartsReadsAsTheObj) {
   EXPECT_EQ(m.corner_vertex, obj.mesh.corner_vertex);
   fs::remove_all(dir);
 }
+
+TEST(FbxControlPoints, TrianglesAndQuadsOfTwoMaterialsComeBackInFileOrder) {
+  // assimp's SortByPType splits each material's aiMesh into its triangles and its quads: four
+  // aiMeshes here (slot 1 quads, slot 1 triangles, slot 0 quads, slot 0 triangles), put back
+  // into the file's order.
+  const std::vector<double> cps{0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0, 3, 1, 0};
+  const std::vector<std::vector<std::int32_t>> polygons{{0, 1, 5}, {0, 5, 4}, {1, 2, 6, 5}, {2, 3, 7}, {2, 7, 6}};
+  const SceneReadResult r = read_fbx(mesh_file(cps, polygons, {1, 0, 1, 0, 1}));
+  ASSERT_TRUE(r.ok()) << r.error;
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  EXPECT_EQ(r.scene.fbx_control_point_meshes, 1u) << r.scene.fbx_note;
+  const PolyMesh& m = r.scene.meshes[0].mesh;
+  ASSERT_EQ(m.num_faces(), 5u);
+  EXPECT_EQ(m.num_vertices(), 8u);
+  for (Index f = 0; f < 5; ++f) {
+    const std::vector<Index> got(m.face_vertices(f).begin(), m.face_vertices(f).end());
+    EXPECT_EQ(got, std::vector<Index>(polygons[f].begin(), polygons[f].end())) << "face " << f;
+    EXPECT_EQ(m.material_names[m.face_material[f]], f % 2 ? "mata" : "matb") << "face " << f;
+  }
+}

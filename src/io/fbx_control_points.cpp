@@ -4,9 +4,8 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
-#include <cmath>
 #include <map>
-#include <numeric>
+#include <tuple>
 
 namespace quadlod::fbx {
 
@@ -63,18 +62,30 @@ std::string read_geometry(const Record& g, MeshGeometry& out) {
   return {};
 }
 
+/// Which polygons an aiMesh holds by size: SortByPType splits a mesh of triangles and larger
+/// polygons into one aiMesh of each (and removes points and lines).
+enum SizeClass : unsigned { kTriangles = 1, kPolygons = 2 };
+
+unsigned size_classes(const aiMesh& a) {
+  unsigned classes = 0;
+  for (unsigned f = 0; f < a.mNumFaces; ++f) classes |= a.mFaces[f].mNumIndices == 3 ? unsigned{kTriangles} : a.mFaces[f].mNumIndices > 3 ? unsigned{kPolygons} : 0u;
+  return classes;
+}
+
 /// Whether aiMesh `a` is the polygons of `g` with material `material` (any material when
-/// `material` is empty), and if so each aiMesh face's polygon.
-bool matches(const aiMesh& a, const MeshGeometry& g, const std::int64_t* material, std::vector<Index>& polygon_of_face) {
+/// `material` is null) and a size in `classes`, and if so each aiMesh face's polygon.
+bool matches(const aiMesh& a, const MeshGeometry& g, const std::int64_t* material, unsigned classes,
+             std::vector<Index>& polygon_of_face) {
   polygon_of_face.clear();
   Index p = 0;
   const Index polygons = g.num_polygons();
+  const auto skipped = [&](Index q) {  // not in this aiMesh: another material or size class
+    const Index size = g.polygon_offsets[q + 1] - g.polygon_offsets[q];
+    return (material && g.polygon_material[q] != *material) || size < 3 || !(classes & (size == 3 ? kTriangles : kPolygons));
+  };
   for (unsigned f = 0; f < a.mNumFaces; ++f) {
     const aiFace& face = a.mFaces[f];
-    // The next polygon that assimp kept in this aiMesh: this material, 3 or more corners.
-    while (p < polygons && ((material && g.polygon_material[p] != *material) ||
-                            g.polygon_offsets[p + 1] - g.polygon_offsets[p] < 3))
-      ++p;
+    while (p < polygons && skipped(p)) ++p;
     if (p == polygons) return false;
     const Index begin = g.polygon_offsets[p];
     if (face.mNumIndices != g.polygon_offsets[p + 1] - begin) return false;
@@ -88,10 +99,8 @@ bool matches(const aiMesh& a, const MeshGeometry& g, const std::int64_t* materia
     }
     polygon_of_face.push_back(p++);
   }
-  // Every polygon of that material must be in the aiMesh: none left over.
-  while (p < polygons && ((material && g.polygon_material[p] != *material) ||
-                          g.polygon_offsets[p + 1] - g.polygon_offsets[p] < 3))
-    ++p;
+  // Every polygon of that material and size must be in the aiMesh: none left over.
+  while (p < polygons && skipped(p)) ++p;
   return p == polygons && a.mNumFaces > 0;
 }
 
@@ -134,10 +143,11 @@ bool control_point_faces(const aiScene& scene, const std::vector<unsigned>& grou
   std::vector<Face> faces;
   std::vector<Index> polygon_of_face;
   // (geometry, material) pairs already matched: two aiMeshes are never the same polygons.
-  std::map<std::pair<Index, std::int64_t>, char> used;
+  std::map<std::tuple<Index, std::int64_t, unsigned>, char> used;
   for (unsigned m : group) {
     if (m >= scene.mNumMeshes) return false;
     const aiMesh& a = *scene.mMeshes[m];
+    const unsigned classes = size_classes(a);
     bool found = false;
     for (Index g = 0; g < geometries.size() && !found; ++g) {
       const MeshGeometry& geometry = geometries[g];
@@ -148,9 +158,9 @@ bool control_point_faces(const aiScene& scene, const std::vector<unsigned>& grou
       const bool one_material = materials.size() <= 1;
       for (std::size_t k = 0; k < (one_material ? 1 : materials.size()) && !found; ++k) {
         const std::int64_t key = one_material ? -1 : materials[k];
-        if (used.count({g, key})) continue;
-        if (!matches(a, geometry, one_material ? nullptr : &materials[k], polygon_of_face)) continue;
-        used[{g, key}] = 1;
+        if (used.count({g, key, classes})) continue;
+        if (!matches(a, geometry, one_material ? nullptr : &materials[k], classes, polygon_of_face)) continue;
+        used[{g, key, classes}] = 1;
         for (unsigned f = 0; f < a.mNumFaces; ++f) faces.push_back({g, polygon_of_face[f], m, f});
         found = true;
       }

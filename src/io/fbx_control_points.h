@@ -58,10 +58,11 @@ struct ControlPointFaces {
 
 /// Maps every face corner of the aiMeshes `group` to a control point of `geometries`, in file
 /// order. assimp's FBX importer makes one aiMesh per (geometry, material) with the polygons of
-/// that material in file order, one vertex per corner (points and lines removed by SortByPType);
-/// so aiMesh m is taken to be geometry g's polygons of one material — of those with 3 or more
-/// corners — when the counts agree and every corner's aiMesh position is the float rounding of
-/// its control point. Each aiMesh must match (the first geometry / material that verifies), else
+/// that material in file order, one vertex per corner, and SortByPType splits that into its
+/// triangles and its larger polygons (points and lines removed); so aiMesh m is taken to be
+/// geometry g's polygons of one material and of the sizes m holds (triangles, larger, or both)
+/// when the counts agree and every corner's aiMesh position is the float rounding of its
+/// control point. Each aiMesh must match (the first geometry / material that verifies), else
 /// false and `out` is unspecified. Faces come out in (geometry, polygon) order, vertices in
 /// control-point order: the order the file has them.
 bool control_point_faces(const aiScene& scene, const std::vector<unsigned>& group,
