@@ -201,7 +201,7 @@ class SceneBuilder {
       ++scene_.fbx_control_point_meshes;
     } else {
       if (fbx_ && scene_.fbx_note.empty())
-        scene_.fbx_note = "mesh '" + std::string(ai_.mMeshes[group[0]]->mName.C_Str()) +
+        scene_.fbx_note = "mesh '" + fbx::printable(ai_.mMeshes[group[0]]->mName.C_Str()) +
                           "': corners do not map onto the FBX control points; glued along edges";
       corners = gather_corners(group);
       vertex_of = glue_corners(corners, vertex_count);

@@ -66,6 +66,10 @@ struct ParseResult {
   bool ok() const { return error.empty(); }
 };
 
+/// `text` for an error message: printable ASCII kept, other bytes as \xNN, cut after
+/// `max_length` bytes (names in a hostile file can hold anything, newlines included).
+std::string printable(std::string_view text, std::size_t max_length = 64);
+
 /// True when `bytes` starts with the binary FBX magic (an ASCII FBX does not).
 bool is_binary_fbx(std::string_view bytes);
 

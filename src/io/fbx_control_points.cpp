@@ -26,7 +26,7 @@ const Property* array_of(const Record& record, std::string_view child) {
 /// One Geometry record into `out`; "" or what is wrong with it.
 std::string read_geometry(const Record& g, MeshGeometry& out) {
   out.name = object_name(g.string_property(1));
-  const std::string where = "FBX Geometry '" + out.name + "': ";
+  const std::string where = "FBX Geometry '" + printable(out.name) + "': ";
   const Property* vertices = array_of(g, "Vertices");
   const Property* polygons = array_of(g, "PolygonVertexIndex");
   if (!vertices || !polygons) return {};  // a mesh without faces: nothing to map (no aiMesh either)
