@@ -13,7 +13,7 @@ namespace {
 constexpr std::string_view kMagic("Kaydara FBX Binary  \0\x1a\0", 23);
 constexpr std::size_t kHeaderBytes = 27;  // magic + u32 version
 
-std::string quoted(const std::string& name) { return "'" + printable(name) + "'"; }
+std::string quoted_name(const std::string& name) { return "'" + printable(name) + "'"; }
 
 /// A cursor over the buffer; every read is bounds-checked, the first failure sets `error`.
 class Reader {
@@ -81,10 +81,10 @@ class Reader {
     record.name.assign(bytes_.data() + pos_, name_length);
     pos_ += name_length;
     const std::size_t properties_start = pos_;
-    if (property_bytes > end - pos_) return fail(start, "record " + quoted(record.name) + ": property list runs past the record's end");
+    if (property_bytes > end - pos_) return fail(start, "record " + quoted_name(record.name) + ": property list runs past the record's end");
     const std::size_t properties_end = pos_ + static_cast<std::size_t>(property_bytes);
     // Each property is at least 2 bytes (code + a 1-byte scalar): the count is bounded before reserving.
-    if (property_count > property_bytes / 2 + 1) return fail(start, "record " + quoted(record.name) + ": " + std::to_string(property_count) + " properties in " + std::to_string(property_bytes) + " bytes");
+    if (property_count > property_bytes / 2 + 1) return fail(start, "record " + quoted_name(record.name) + ": " + std::to_string(property_count) + " properties in " + std::to_string(property_bytes) + " bytes");
     record.properties.reserve(static_cast<std::size_t>(property_count));
     const std::string_view saved = bytes_;
     bytes_ = bytes_.substr(0, properties_end);  // a property may not read past the list
@@ -94,7 +94,7 @@ class Reader {
       record.properties.push_back(std::move(p));
     }
     bytes_ = saved;
-    if (pos_ != properties_end) return fail(properties_start, "record " + quoted(record.name) + ": properties end at byte " + std::to_string(pos_) + ", the list says " + std::to_string(properties_end));
+    if (pos_ != properties_end) return fail(properties_start, "record " + quoted_name(record.name) + ": properties end at byte " + std::to_string(pos_) + ", the list says " + std::to_string(properties_end));
     if (pos_ < end) {
       if (depth + 1 > params_.max_depth) return fail(start, "records nested deeper than " + std::to_string(params_.max_depth));
       bool closed = false;
@@ -110,7 +110,7 @@ class Reader {
       }
       // Tolerated: a list that fills its record without the NULL record (assimp 5.2's own writer).
       (void)closed;
-      if (pos_ != end) return fail(start, "record " + quoted(record.name) + ": nested records end at byte " + std::to_string(pos_) + ", the record at " + std::to_string(end));
+      if (pos_ != end) return fail(start, "record " + quoted_name(record.name) + ": nested records end at byte " + std::to_string(pos_) + ", the record at " + std::to_string(end));
     }
     return true;
   }
@@ -141,7 +141,7 @@ class Reader {
       case 'l': return parse_array<std::int64_t>(p, at, record);
       case 'b': return parse_array<std::uint8_t>(p, at, record);
       default:
-        return fail(at, "record " + quoted(record) + ": unknown property type 0x" + hex(code));
+        return fail(at, "record " + quoted_name(record) + ": unknown property type 0x" + hex(code));
     }
   }
 
@@ -150,7 +150,7 @@ class Reader {
     std::uint32_t count = 0, encoding = 0, stored = 0;
     if (!u32(count) || !u32(encoding) || !u32(stored) || !need(stored, "array data")) return false;
     const std::uint64_t bytes = std::uint64_t{count} * sizeof(T);
-    const std::string where = "record " + quoted(record) + ": array of " + std::to_string(count) + " '" + std::string(1, p.type) + "'";
+    const std::string where = "record " + quoted_name(record) + ": array of " + std::to_string(count) + " '" + std::string(1, p.type) + "'";
     std::string inflated;
     const char* data = bytes_.data() + pos_;
     if (encoding == 0) {
