@@ -13,7 +13,12 @@ namespace {
 constexpr std::string_view kMagic("Kaydara FBX Binary  \0\x1a\0", 23);
 constexpr std::size_t kHeaderBytes = 27;  // magic + u32 version
 
-std::string quoted_name(const std::string& name) { return "'" + printable(name) + "'"; }
+std::string quoted_name(const std::string& name) {
+  std::string out(1, '\'');  // (not "'" + …: GCC 12 warns falsely on that concatenation)
+  out += printable(name);
+  out += '\'';
+  return out;
+}
 
 /// A cursor over the buffer; every read is bounds-checked, the first failure sets `error`.
 class Reader {
