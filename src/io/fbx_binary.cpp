@@ -85,6 +85,8 @@ class Reader {
     if (!need(name_length, "record name")) return false;
     record.name.assign(bytes_.data() + pos_, name_length);
     pos_ += name_length;
+    // (Before any subtraction from `end`: a header and name longer than the record would wrap.)
+    if (pos_ > end) return fail(start, "record " + quoted_name(record.name) + ": header and name run past the record's end");
     const std::size_t properties_start = pos_;
     if (property_bytes > end - pos_) return fail(start, "record " + quoted_name(record.name) + ": property list runs past the record's end");
     const std::size_t properties_end = pos_ + static_cast<std::size_t>(property_bytes);
