@@ -113,7 +113,8 @@ bool scene_readable_path(const std::filesystem::path& path);
 ///     along edges — two half-edges on the same two positions (exact float equality) running
 ///     opposite ways make their faces neighbours — so the topology the exporter split at UV /
 ///     normal / material seams comes back while parts that only touch, or lie on top of each
-///     other, stay apart; UV sets (all of them, named when the file names them), normals and the
+///     other, stay apart (a binary FBX not written by assimp: its control points are the
+///     vertices instead, where every corner verifiably maps onto one — Scene::fbx_note); UV sets (all of them, named when the file names them), normals and the
 ///     first colour set are pools with one index per corner (deduplicated by value; the normals
 ///     of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
 ///   * drops points, lines and faces with fewer than 3 distinct corners (counted in
