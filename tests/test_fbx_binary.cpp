@@ -179,6 +179,14 @@ TEST(FbxControlPoints, PartsWhoseBoundariesCoincideStayTwoParts) {
   EXPECT_EQ(std::vector<Index>(m.face_vertices(0).begin(), m.face_vertices(0).end()), (std::vector<Index>{0, 1, 2, 3}));
   EXPECT_EQ(std::vector<Index>(m.face_vertices(1).begin(), m.face_vertices(1).end()), (std::vector<Index>{6, 4, 5, 7}));
 
+  SceneReadOptions glue;
+  glue.fbx_control_points = false;
+  const std::string bytes = two_quads(false);
+  const SceneReadResult off = read_scene_from_memory(bytes.data(), bytes.size(), "fbx", "t.fbx", glue);
+  ASSERT_TRUE(off.ok()) << off.error;
+  EXPECT_EQ(off.scene.fbx_control_point_meshes, 0u);
+  EXPECT_EQ(off.scene.meshes[0].mesh.num_vertices(), 6u);  // glued: the two parts become one
+
   const SceneReadResult one = read_fbx(two_quads(true));
   ASSERT_TRUE(one.ok()) << one.error;
   EXPECT_EQ(one.scene.meshes[0].mesh.num_vertices(), 6u);

@@ -82,6 +82,10 @@ struct SceneReadOptions {
   /// normal seam to the reduction (src/mesh/features.h), so without this every edge of a smooth
   /// mesh read from FBX would be one. Real creases are degrees apart. 0 = exact equality only.
   double normal_weld_degrees = 0.1;
+  /// Binary FBX: take each mesh's vertices from the file's control points where every corner
+  /// verifiably maps onto one (src/io/fbx_control_points.h); false glues corners along edges as
+  /// for the other assimp formats.
+  bool fbx_control_points = true;
 };
 
 struct SceneReadResult {

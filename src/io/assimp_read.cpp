@@ -604,7 +604,7 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
   }
   fbx::GeometryRead geometries;
   std::string note;
-  const bool binary_fbx = fbx::is_binary_fbx(bytes);
+  const bool binary_fbx = options.fbx_control_points && fbx::is_binary_fbx(bytes);
   if (binary_fbx) {
     geometries = fbx::read_mesh_geometries(bytes);
     if (!geometries.ok())
