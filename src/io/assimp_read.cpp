@@ -8,6 +8,10 @@
 //   aiMesh "body/mat B" ─┼─► on the same positions (glue_corners), per-corner UV / normal pools
 //                        │   (deduplicated by value), face_material from each aiMesh's material
 //
+// A binary FBX that assimp did not write keeps its own vertices instead of being glued: its
+// control points, read by src/io/fbx_binary.cpp and mapped onto assimp's corners with a check
+// (src/io/fbx_control_points.h, docs/scenes.md).
+//
 // No post-process step triangulates or joins vertices (aiProcess_Triangulate /
 // JoinIdenticalVertices are not used): polygons stay polygons.
 //

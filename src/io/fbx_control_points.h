@@ -43,8 +43,9 @@ struct GeometryRead {
 GeometryRead read_mesh_geometries(std::string_view bytes, const ParseParams& params = {});
 
 /// True when the file's control points are the mesh's own vertices. assimp's FBX exporter
-/// (quadlod's .fbx output) writes its per-corner aiMesh vertices instead, welded by position per
-/// material: those files are glued along edges as every other assimp format is.
+/// (quadlod's .fbx output) writes its aiMesh vertices instead — quadlod's writer makes one per
+/// (vertex, UV, normal) of a corner, so they are split at every seam, one geometry per material:
+/// those files are glued along edges as every other assimp format is.
 bool control_points_are_vertices(const GeometryRead& read);
 
 /// The faces of a group of aiMeshes (one node's, assimp_read.cpp) over control points.
