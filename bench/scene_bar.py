@@ -120,7 +120,7 @@ def main():
                 faces = sum(1 for line in f if line.startswith("f "))
             if faces < a.max_faces:
                 meshes.append(os.path.join(a.corpus, name))
-    worst = {"simplify": 0.0, "lod": 0.0, "simplify32": 0.0, "lod32": 0.0}
+    worst = {"simplify": 0.0, "lod": 0.0, "simplify32": 0.0, "lod32": 0.0, "fbx_vs_32": 0.0, "lod_fbx_vs_32": 0.0}
     print(f"{'mesh':34} {'fmt':4} {'in quads/tris/ngons':>20} {'simplify out (quadlod)':>24} "
           f"{'out (blender)':>18} {'qf':>6} {'dqf':>7} {'lod qf per level':>22} {'dqf':>7} {'s':>6}")
     for mesh in meshes:
@@ -167,6 +167,11 @@ def main():
             if fmt == "fbx":
                 worst["simplify"] = max(worst["simplify"], abs(dqf))
                 worst["lod"] = max(worst["lod"], lod_d)
+                # The FBX holds Blender's float32 coordinates: against the float32 OBJ, a
+                # difference is the FBX path's own (its input or its normals), not rounding.
+                worst["fbx_vs_32"] = max(worst["fbx_vs_32"], abs(qf - quad_fraction(*results["obj32"]["counts"])))
+                worst["lod_fbx_vs_32"] = max(worst["lod_fbx_vs_32"], max(
+                    abs(x - y) for x, y in zip(r["lod_qf"], results["obj32"]["lod_qf"])))
                 # Blender must see the quads quadlod wrote.
                 if bl and bl[0] != r["counts"][0]:
                     bl_text += " MISMATCH"
@@ -178,7 +183,8 @@ def main():
                   f"{r['seconds']:6.1f}", flush=True)
     print(f"largest |quad fraction (fbx) - quad fraction (obj)|: simplify {worst['simplify']:.4f}, "
           f"lod {worst['lod']:.4f} (bar: 0.01); the OBJ rounded to float32 against the OBJ: "
-          f"simplify {worst['simplify32']:.4f}, lod {worst['lod32']:.4f}")
+          f"simplify {worst['simplify32']:.4f}, lod {worst['lod32']:.4f}; fbx against the float32 OBJ: "
+          f"simplify {worst['fbx_vs_32']:.4f}, lod {worst['lod_fbx_vs_32']:.4f}")
 
 
 if __name__ == "__main__":

@@ -60,4 +60,9 @@ bool encode_pipeline_case(const PolyMesh& mesh, double ratio, std::uint8_t flags
 /// indices exist. `hint` is the format's extension without the dot ("glb", "dae", "fbx").
 std::string check_scene(std::string_view hint, std::string_view bytes);
 
+/// The binary FBX reader (src/io/fbx_control_points.h, issue 21): read_mesh_geometries either
+/// refuses with one line starting "FBX " (and no geometries) or returns geometries whose polygons
+/// name existing control points, with finite positions and one material slot per polygon if any.
+std::string check_fbx_binary(std::string_view bytes);
+
 }  // namespace quadlod::fuzz

@@ -18,6 +18,7 @@ std::string run(std::string_view target, std::string_view bytes) {
   if (target == "ply") return fuzz::check_reader(MeshFormat::Ply, bytes);
   if (target == "off") return fuzz::check_reader(MeshFormat::Off, bytes);
   if (target == "pipeline") return fuzz::check_pipeline(bytes);
+  if (target == "fbx_binary") return fuzz::check_fbx_binary(bytes);
 #ifdef QUADLOD_FUZZ_HAS_SCENE
   // The assimp front end: glTF binary, the format with the largest parser surface of the three
   // quadlod writes (fuzz_assimp_dae / _fbx: same driver, other hints).

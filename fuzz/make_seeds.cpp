@@ -87,8 +87,21 @@ int main(int argc, char** argv) {
       fs::create_directories(root);
       if (write_scene(scene_from_mesh(mesh, name), file).ok()) {
         std::ifstream in(file, std::ios::binary);
-        save(root / target, name + ext, std::string(std::istreambuf_iterator<char>(in), {}));
+        const std::string bytes(std::istreambuf_iterator<char>(in), {});
+        save(root / target, name + ext, bytes);
         ++written;
+        if (std::string(target) == "assimp_fbx") {
+          // The binary FBX reader's own target, and a copy under another Creator so that the
+          // assimp target also maps corners onto control points (fbx_control_points.h skips
+          // files assimp wrote).
+          save(root / "fbx_binary", name + ext, bytes);
+          std::string other = bytes;
+          const std::string creator = "Open Asset Import Library";
+          for (std::size_t at = other.find(creator); at != std::string::npos; at = other.find(creator, at))
+            other.replace(at, creator.size(), "Some Other Exporter Tool!");
+          save(root / target, name + "-other-creator" + ext, other);
+          written += 2;
+        }
       }
       fs::remove(file);
     }

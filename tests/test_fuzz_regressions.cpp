@@ -27,6 +27,7 @@ std::string run_target(const std::string& target, std::string_view bytes) {
   if (target == "ply") return fuzz::check_reader(MeshFormat::Ply, bytes);
   if (target == "off") return fuzz::check_reader(MeshFormat::Off, bytes);
   if (target == "pipeline") return fuzz::check_pipeline(bytes);
+  if (target == "fbx_binary") return fuzz::check_fbx_binary(bytes);
 #ifdef QUADLOD_FUZZ_HAS_SCENE
   if (target == "assimp") return fuzz::check_scene("glb", bytes);
   if (target == "assimp_dae") return fuzz::check_scene("dae", bytes);

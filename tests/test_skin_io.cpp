@@ -293,7 +293,20 @@ bpy.ops.export_scene.fbx(filepath=dst, add_leaf_bones=False, bake_anim=True, bak
     if (!m.mesh.skin.empty()) mesh = &m.mesh;
   ASSERT_NE(mesh, nullptr);
   ASSERT_EQ(mesh->check_layout(), "");
-  EXPECT_EQ(mesh->num_vertices(), tube.mesh.num_vertices());
+  // The FBX's own vertices (its control points, issue 21): Blender's glTF import keeps the glb's
+  // vertices split at the UV seam, and so does its FBX. Glued along edges instead
+  // (SceneReadOptions::fbx_control_points = false), the seam closes into the tube's vertices.
+  EXPECT_EQ(r.scene.fbx_control_point_meshes, r.scene.meshes.size()) << r.scene.fbx_note;
+  EXPECT_GT(mesh->num_vertices(), tube.mesh.num_vertices());
+  SceneReadOptions glue;
+  glue.fbx_control_points = false;
+  const SceneReadResult glued = read_scene(fbx, glue);
+  ASSERT_TRUE(glued.ok()) << glued.error;
+  for (const SceneMesh& m : glued.scene.meshes) {
+    if (!m.mesh.skin.empty()) {
+      EXPECT_EQ(m.mesh.num_vertices(), tube.mesh.num_vertices());
+    }
+  }
   EXPECT_LE(mesh->skin.max_influences(), 2u);
   const Rig& rig = r.scene.rig;
   ASSERT_EQ(rig.skeleton.check(), "");

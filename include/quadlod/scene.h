@@ -57,6 +57,11 @@ struct Scene {
   /// line primitives); informational, for `quadlod info`-style summaries and for tests.
   Index cameras = 0, lights = 0, animations = 0;
   std::uint64_t dropped_primitives = 0;  ///< points / lines / faces with < 3 distinct corners
+  /// Binary FBX: how many meshes took their vertices from the file's control points (the exact
+  /// vertices and float64 positions; src/io/fbx_control_points.h) instead of gluing corners, and
+  /// when some did not, why (one line; empty otherwise).
+  Index fbx_control_point_meshes = 0;
+  std::string fbx_note;
   /// Skeleton and animations (issue 24): the joints are the nodes the meshes' bones name (plus
   /// the nodes between them), with their hierarchy, local transforms as rest pose and the bones'
   /// offset matrices as inverse bind matrices; animation channels on joints, times in seconds.
@@ -77,6 +82,10 @@ struct SceneReadOptions {
   /// normal seam to the reduction (src/mesh/features.h), so without this every edge of a smooth
   /// mesh read from FBX would be one. Real creases are degrees apart. 0 = exact equality only.
   double normal_weld_degrees = 0.1;
+  /// Binary FBX: take each mesh's vertices from the file's control points where every corner
+  /// verifiably maps onto one (src/io/fbx_control_points.h); false glues corners along edges as
+  /// for the other assimp formats.
+  bool fbx_control_points = true;
 };
 
 struct SceneReadResult {
@@ -108,7 +117,8 @@ bool scene_readable_path(const std::filesystem::path& path);
 ///     along edges — two half-edges on the same two positions (exact float equality) running
 ///     opposite ways make their faces neighbours — so the topology the exporter split at UV /
 ///     normal / material seams comes back while parts that only touch, or lie on top of each
-///     other, stay apart; UV sets (all of them, named when the file names them), normals and the
+///     other, stay apart (a binary FBX not written by assimp: its control points are the
+///     vertices instead, where every corner verifiably maps onto one — Scene::fbx_note); UV sets (all of them, named when the file names them), normals and the
 ///     first colour set are pools with one index per corner (deduplicated by value; the normals
 ///     of one vertex within SceneReadOptions::normal_weld_degrees share an entry);
 ///   * drops points, lines and faces with fewer than 3 distinct corners (counted in

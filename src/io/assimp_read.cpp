@@ -8,12 +8,17 @@
 //   aiMesh "body/mat B" ─┼─► on the same positions (glue_corners), per-corner UV / normal pools
 //                        │   (deduplicated by value), face_material from each aiMesh's material
 //
+// A binary FBX that assimp did not write keeps its own vertices instead of being glued: its
+// control points, read by src/io/fbx_binary.cpp and mapped onto assimp's corners with a check
+// (src/io/fbx_control_points.h, docs/scenes.md).
+//
 // No post-process step triangulates or joins vertices (aiProcess_Triangulate /
 // JoinIdenticalVertices are not used): polygons stay polygons.
 //
 // Issue 24 (skins) adds bones / weights in `per_mesh_extras` and skeleton / animations in
 // `scene_extras`; nothing else here needs to change for it.
 #include "io/assimp_detail.h"
+#include "io/fbx_control_points.h"
 #include "mesh/union_find.h"
 #include "quadlod/scene.h"
 
@@ -29,6 +34,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <unordered_map>
 
@@ -95,8 +101,10 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
 
 class SceneBuilder {
  public:
-  SceneBuilder(const aiScene& ai, const SceneReadOptions& options)
-      : ai_(ai), normal_weld_cos_(std::cos(options.normal_weld_degrees * 3.14159265358979323846 / 180.0)) {}
+  /// `fbx`: the file's FBX geometries when it is a binary FBX whose control points are its
+  /// vertices (fbx_control_points.h), else nullptr (every mesh glued).
+  SceneBuilder(const aiScene& ai, const SceneReadOptions& options, const fbx::GeometryRead* fbx)
+      : ai_(ai), normal_weld_cos_(std::cos(options.normal_weld_degrees * 3.14159265358979323846 / 180.0)), fbx_(fbx) {}
 
   Scene build() {
     for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.materials.push_back(read_material(*ai_.mMaterials[i], i));
@@ -186,9 +194,22 @@ class SceneBuilder {
       normals = normals || a.HasNormals();
       colours = colours || a.HasVertexColors(0);
     }
-    Corners corners = gather_corners(group);
+    // A binary FBX's own vertices (its control points, float64) where every corner maps onto
+    // one; else the corners glued along edges.
+    Corners corners;
     Index vertex_count = 0;
-    const std::vector<Index> vertex_of = glue_corners(corners, vertex_count);
+    std::vector<Index> vertex_of;
+    std::vector<Vec3> exact_positions;
+    if (fbx_ && from_control_points(group, corners, vertex_of, exact_positions)) {
+      vertex_count = static_cast<Index>(exact_positions.size());
+      ++scene_.fbx_control_point_meshes;
+    } else {
+      if (fbx_ && scene_.fbx_note.empty())
+        scene_.fbx_note = "mesh '" + fbx::printable(ai_.mMeshes[group[0]]->mName.C_Str()) +
+                          "': corners do not map onto the FBX control points; glued along edges";
+      corners = gather_corners(group);
+      vertex_of = glue_corners(corners, vertex_count);
+    }
 
     mesh.positions.resize(vertex_count);
     std::vector<char> placed(vertex_count, 0);
@@ -224,7 +245,8 @@ class SceneBuilder {
         if (welded_of[v] == kInvalidIndex) welded_of[v] = w;
         if (!placed[w]) {
           placed[w] = 1;
-          mesh.positions[w] = Vec3(a.mVertices[v].x, a.mVertices[v].y, a.mVertices[v].z);
+          mesh.positions[w] = exact_positions.empty() ? Vec3(a.mVertices[v].x, a.mVertices[v].y, a.mVertices[v].z)
+                                                      : exact_positions[w];
           if (colours && a.HasVertexColors(0)) {
             const aiColor4D& col = a.mColors[0][v];
             mesh.vertex_colors[w] = Vec3(col.r, col.g, col.b);
@@ -280,6 +302,21 @@ class SceneBuilder {
     std::vector<Index> position;
     std::vector<Index> face_offsets{0};
   };
+
+  /// The group's faces over the FBX control points (fbx::control_point_faces): each corner's
+  /// vertex is its control point, so `position` (what the drop rules compare) is the vertex too.
+  bool from_control_points(const std::vector<unsigned>& group, Corners& corners, std::vector<Index>& vertex_of,
+                           std::vector<Vec3>& positions) const {
+    fbx::ControlPointFaces faces;
+    if (!fbx::control_point_faces(ai_, group, fbx_->geometries, faces)) return false;
+    corners.mesh = std::move(faces.mesh);
+    corners.vertex = std::move(faces.mesh_vertex);
+    corners.position = faces.vertex;
+    corners.face_offsets = std::move(faces.face_offsets);
+    vertex_of = std::move(faces.vertex);
+    positions = std::move(faces.positions);
+    return true;
+  }
   Corners gather_corners(const std::vector<unsigned>& group) {
     Corners out;
     std::unordered_map<FloatKey, Index, FloatKeyHash> position_of;
@@ -540,6 +577,7 @@ class SceneBuilder {
 
   const aiScene& ai_;
   const double normal_weld_cos_;
+  const fbx::GeometryRead* fbx_;
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
   std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
@@ -556,8 +594,11 @@ void configure(Assimp::Importer& importer) {
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
 }
 
+/// `bytes`: the file's bytes when it may be a binary FBX (else empty): its control points give
+/// the meshes their vertices (fbx_control_points.h). A binary FBX that assimp reads but our
+/// parser refuses, or one written by assimp, is glued as before, with Scene::fbx_note saying why.
 SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
-                       const SceneReadOptions& options) {
+                       const SceneReadOptions& options, std::string_view bytes) {
   SceneReadResult result;
   if (!ai) {
     std::string message = importer.GetErrorString();
@@ -565,8 +606,37 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
     result.error = name + ": assimp: " + message;
     return result;
   }
-  result.scene = SceneBuilder(*ai, options).build();
+  fbx::GeometryRead geometries;
+  std::string note;
+  const bool binary_fbx = options.fbx_control_points && fbx::is_binary_fbx(bytes);
+  if (binary_fbx) {
+    geometries = fbx::read_mesh_geometries(bytes);
+    if (!geometries.ok())
+      note = "FBX control points not read (" + geometries.error + "); corners glued along edges";
+    else if (!fbx::control_points_are_vertices(geometries))
+      note = "FBX written by assimp (per-corner control points); corners glued along edges";
+  }
+  const bool use = binary_fbx && note.empty();
+  result.scene = SceneBuilder(*ai, options, use ? &geometries : nullptr).build();
+  if (!note.empty()) result.scene.fbx_note = note;
   return result;
+}
+
+/// The file's bytes when it starts with the binary FBX magic, else "".
+std::string binary_fbx_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[32] = {};
+  in.read(head, sizeof head);
+  if (!fbx::is_binary_fbx(std::string_view(head, static_cast<std::size_t>(in.gcount())))) return {};
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size <= 0) return {};
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), size);
+  if (in.gcount() != size) return {};
+  return bytes;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -588,7 +658,8 @@ SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const 
   Assimp::Importer importer;
   configure(importer);
   const aiScene* ai = importer.ReadFile(path.string(), kImportSteps);
-  SceneReadResult result = finish(ai, importer, path.string(), options);
+  const std::string fbx_bytes = ai ? binary_fbx_bytes(path) : std::string();
+  SceneReadResult result = finish(ai, importer, path.string(), options, fbx_bytes);
   result.seconds = seconds_since(start);
   return result;
 }
@@ -605,7 +676,7 @@ SceneReadResult read_scene_from_memory(const void* data, std::size_t size, std::
   if (size == 0)
     result.error = name + ": empty buffer";
   else
-    result = finish(ai, importer, name, options);
+    result = finish(ai, importer, name, options, std::string_view(static_cast<const char*>(data), size));
   result.seconds = seconds_since(start);
   return result;
 }
