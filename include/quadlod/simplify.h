@@ -109,9 +109,9 @@ struct SimplifyOptions {
   /// keep the output closer to the target (report: `fallback`). Beyond the paper; off in
   /// measurements of the selection itself (bench/selection_quality).
   bool greedy_fallback = true;
-  /// Decide on the positions rounded to float32, the precision FBX, glTF and DCC tools store,
-  /// so that an OBJ and its FBX / glb reduce alike; vertices that do not move keep their input
-  /// coordinates (docs/scenes.md, "One mesh, any format"). false: decide on the doubles as read.
+  /// Decide on the positions, UVs and normals rounded to float32, the precision FBX, glTF and DCC
+  /// tools store, so that an OBJ and its FBX / glb reduce alike; what does not move keeps its
+  /// input values (docs/scenes.md, "One mesh, any format"). false: decide on the doubles as read.
   bool float32_decisions = true;
 
   // --- ablations (paper Table 2) ----------------------------------------------------------------

@@ -859,17 +859,17 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
   return std::move(kept);
 }
 
-// Decisions on float32 positions, so that a mesh reduces the same from an OBJ as from its FBX or
-// glTF (src/pipeline/storage_precision.h); the vertices that did not move keep the input's own
-// coordinates.
+// Decisions on float32 positions, UVs and normals, so that a mesh reduces the same from an OBJ as
+// from its FBX or glTF (src/pipeline/storage_precision.h); what did not move keeps the input's own
+// values.
 SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   if (!options.float32_decisions) return simplify_on(input, options);
-  std::optional<PolyMesh> rounded = with_float32_positions(input);
+  std::optional<PolyMesh> rounded = with_float32_attributes(input);
   if (!rounded) return simplify_on(input, options);
   SimplifyResult result = simplify_on(*rounded, options);
   rounded.reset();
-  if (result.ok()) restore_input_positions(input, result.mesh);
-  result.report["float32_decisions"] = true;  // the positions were rounded for the decisions
+  if (result.ok()) restore_input_values(input, result.mesh);
+  result.report["float32_decisions"] = true;  // the values were rounded for the decisions
   return result;
 }
 

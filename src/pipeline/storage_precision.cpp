@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <unordered_map>
+#include <vector>
 
 namespace quadlod {
 
@@ -12,53 +13,95 @@ namespace {
 
 bool rounds_to_float(double x) { return std::isfinite(x) && std::abs(x) <= double(FLT_MAX); }
 
-Vec3 rounded(const Vec3& p) { return {double(float(p.x())), double(float(p.y())), double(float(p.z()))}; }
+// double → float32 → double. Through a volatile float: g++ 12.2's SLP vectorizer drops the
+// float truncation of the first two coordinates of `Vec3(double(float(p.x())), …)` and of the
+// same loop at -O2 (it stores the doubles unchanged; seen in its output, tested below by
+// Simplify.DecisionsAreOnFloat32SoTheStoragePrecisionDoesNotMatter).
+double to_float32(double x) {
+  volatile float f = static_cast<float>(x);
+  return static_cast<double>(f);
+}
 
+template <class V>
+V rounded(const V& p) {
+  V r;
+  for (int i = 0; i < int(V::RowsAtCompileTime); ++i) r[i] = to_float32(p[i]);
+  return r;
+}
+
+// The float32 bits of a (rounded) point, as a map key.
 struct FloatKey {
-  std::uint32_t x, y, z;
+  std::uint32_t c[3] = {0, 0, 0};
   bool operator==(const FloatKey&) const = default;
 };
 struct FloatKeyHash {
   std::size_t operator()(const FloatKey& k) const {
-    std::uint64_t h = k.x;
-    h = h * 0x9E3779B97F4A7C15ull ^ k.y;
-    h = h * 0x9E3779B97F4A7C15ull ^ k.z;
+    std::uint64_t h = k.c[0];
+    h = h * 0x9E3779B97F4A7C15ull ^ k.c[1];
+    h = h * 0x9E3779B97F4A7C15ull ^ k.c[2];
     return std::size_t(h ^ (h >> 29));
   }
 };
-FloatKey key_of(const Vec3& p) {
-  const float f[3] = {float(p.x()), float(p.y()), float(p.z())};
+template <class V>
+FloatKey key_of(const V& p) {
   FloatKey k;
-  std::memcpy(&k.x, &f[0], 4);
-  std::memcpy(&k.y, &f[1], 4);
-  std::memcpy(&k.z, &f[2], 4);
+  for (int i = 0; i < int(V::RowsAtCompileTime); ++i) {
+    const float f = float(p[i]);
+    std::memcpy(&k.c[i], &f, 4);
+  }
   return k;
+}
+
+// False when a value cannot be rounded (beyond float32's range, or not finite); `changes` is
+// set when rounding moves one.
+template <class V>
+bool check(const std::vector<V>& values, bool& changes) {
+  for (const V& p : values) {
+    for (int i = 0; i < int(V::RowsAtCompileTime); ++i)
+      if (!rounds_to_float(p[i])) return false;
+    changes = changes || rounded(p) != p;
+  }
+  return true;
+}
+
+template <class V>
+void round_all(std::vector<V>& values) {
+  for (V& p : values) p = rounded(p);
+}
+
+// Values of `output` that are exactly a rounded value of `input` get that input value back.
+template <class V>
+void restore(const std::vector<V>& input, std::vector<V>& output) {
+  std::unordered_map<FloatKey, std::size_t, FloatKeyHash> at;
+  at.reserve(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) at.emplace(key_of(input[i]), i);
+  for (V& p : output) {
+    if (rounded(p) != p) continue;  // a new value off the float32 grid: not an input value
+    const auto it = at.find(key_of(p));
+    if (it != at.end()) p = input[it->second];
+  }
 }
 
 }  // namespace
 
-std::optional<PolyMesh> with_float32_positions(const PolyMesh& mesh) {
+std::optional<PolyMesh> with_float32_attributes(const PolyMesh& mesh) {
   bool changes = false;
-  for (const Vec3& p : mesh.positions) {
-    for (int i = 0; i < 3; ++i)
-      if (!rounds_to_float(p[i])) return std::nullopt;
-    changes = changes || rounded(p) != p;
-  }
+  if (!check(mesh.positions, changes) || !check(mesh.normals, changes)) return std::nullopt;
+  for (const UvSet& set : mesh.uv_sets)
+    if (!check(set.values, changes)) return std::nullopt;
   if (!changes) return std::nullopt;
   PolyMesh out = mesh;
-  for (Vec3& p : out.positions) p = rounded(p);
+  round_all(out.positions);
+  round_all(out.normals);
+  for (UvSet& set : out.uv_sets) round_all(set.values);
   return out;
 }
 
-void restore_input_positions(const PolyMesh& input, PolyMesh& output) {
-  std::unordered_map<FloatKey, Index, FloatKeyHash> at;
-  at.reserve(input.positions.size());
-  for (Index v = 0; v < input.num_vertices(); ++v) at.emplace(key_of(input.positions[v]), v);
-  for (Vec3& p : output.positions) {
-    if (rounded(p) != p) continue;  // a new placement off the float32 grid: not an input point
-    const auto it = at.find(key_of(p));
-    if (it != at.end()) p = input.positions[it->second];
-  }
+void restore_input_values(const PolyMesh& input, PolyMesh& output) {
+  restore(input.positions, output.positions);
+  restore(input.normals, output.normals);
+  for (std::size_t k = 0; k < std::min(input.uv_sets.size(), output.uv_sets.size()); ++k)
+    restore(input.uv_sets[k].values, output.uv_sets[k].values);
 }
 
 }  // namespace quadlod
