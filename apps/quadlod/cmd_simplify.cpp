@@ -29,6 +29,7 @@ struct SimplifyCliOptions {
   bool per_mesh = false;
   std::string rig, glb;  // issue 24: skinned input / skinned .glb output
   std::string skin_border_bones = "any";
+  Index skin_poses = 0;  // issue 24: poses of the rig's animations the quadrics are measured in
   std::uint64_t max_memory = 0;  ///< bytes; 0 = no bound
 };
 
@@ -150,6 +151,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                   "Keep edges whose endpoints' weights differ by more than this and follow unrelated bones (> 1 = off)")
       ->check(CLI::Range(0.0, 2.0))
       ->capture_default_str();
+  sub->add_option("--skin-poses", opt->skin_poses,
+                  "Measure the reduction's error in up to this many frames of the rig's animations besides the bind "
+                  "pose (deformation-sensitive quadrics, docs/skinning.md); 0 = the bind pose only")
+      ->capture_default_str();
   sub->add_option("--skin-border-bones", opt->skin_border_bones,
                   "Which bones --skin-border separates: any two dominant joints, or unrelated ones only (parent and child may merge)")
       ->check(CLI::IsMember({"any", "unrelated"}))
@@ -212,8 +217,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             bool skinned = !opt->rig.empty() || !opt->glb.empty();
             MeshFormat native_in;
             if (!skinned && is_gltf_path(opt->input)) {
+              // A glTF of several meshes takes the scene path below, which writes a .glb with
+              // every mesh's skin (docs/skinning.md, "Scenes").
               in = read_skinned_input(opt->input, "");
-              skinned = in.error.empty();
+              skinned = in.error.empty() && in.file_meshes == 1;
             } else if (!skinned && is_gltf_path(opt->output) && !format_from_path(opt->input, native_in) &&
                        scene_readable_path(opt->input)) {
               // A skinned FBX / Collada of one mesh to .glb: its skin, skeleton and animations
@@ -244,6 +251,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             }
             if (opt->skin_border_bones == "unrelated")
               for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
+            if (!in.mesh.skin.empty()) p.skin_poses = rig_poses(in.rig, opt->skin_poses);
             const double read_seconds = clock.seconds();
             SimplifyResult r = simplify(in.mesh, p);
             if (!r.ok()) return fail(opt->input + ": " + r.error);

@@ -27,6 +27,7 @@ SkinnedInput read_skinned_input(const std::string& path, const std::string& rig_
     in.mesh = std::move(r.skinned.mesh);
     in.rig = std::move(r.skinned.rig);
     in.material_colors = std::move(r.material_colors);
+    in.file_meshes = r.mesh_nodes;
   } else if (MeshFormat native; !format_from_path(path, native) && scene_readable_path(path)) {
     // FBX, Collada, … through assimp (issue 21's reader): the first skinned mesh and the rig.
     SceneReadResult r = read_scene(path);
@@ -90,6 +91,22 @@ std::string remap_joints(PolyMesh& mesh, const Skeleton& from, const Skeleton& t
     }
   mesh.skin = make_skin_weights(lists);
   return {};
+}
+
+std::vector<std::vector<Mat4>> rig_poses(const Rig& rig, Index max_poses) {
+  std::vector<std::pair<Index, double>> frames;  // (animation, time)
+  for (Index a = 0; a < rig.animations.size(); ++a)
+    for (double t : rig.animations[a].frame_times()) frames.emplace_back(a, t);
+  std::vector<std::vector<Mat4>> poses;
+  if (max_poses == 0 || frames.empty()) return poses;
+  const std::size_t n = std::min<std::size_t>(max_poses, frames.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = n == 1 ? 0 : k * (frames.size() - 1) / (n - 1);
+    const auto& [a, t] = frames[i];
+    const Skeleton& s = rig.skeleton;
+    poses.push_back(skinning_matrices(s, global_joint_matrices(s, sample_pose(s, rig.animations[a], t))));
+  }
+  return poses;
 }
 
 }  // namespace quadlod::cli

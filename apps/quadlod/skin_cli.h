@@ -16,7 +16,7 @@ struct SkinnedInput {
   Rig rig;        ///< empty when neither the file nor --rig has one
   std::vector<std::pair<std::string, Eigen::Vector4d>> material_colors;
   std::string error;
-  /// Meshes in the file (1 for glTF through read_skinned_gltf and for OBJ / PLY / OFF).
+  /// Meshes in the file (glTF: nodes with a mesh; 1 for OBJ / PLY / OFF).
   std::size_t file_meshes = 1;
   /// Filled when the weights came by projection from the rig file's mesh.
   bool projected = false;
@@ -36,5 +36,10 @@ SkinnedInput read_skinned_input(const std::string& path, const std::string& rig_
 /// Remaps `mesh.skin` from the joints of `from` to those of `to` by joint name; error when a
 /// joint of `from` that carries weight has no namesake in `to`.
 std::string remap_joints(PolyMesh& mesh, const Skeleton& from, const Skeleton& to);
+
+/// Skinning matrices (per pose, per joint) at up to `max_poses` frames of the rig's animations:
+/// the union of every animation's frame times, taken evenly (first and last included) when there
+/// are more. For SimplifyOptions::skin_poses. 0 or no animation: none.
+std::vector<std::vector<Mat4>> rig_poses(const Rig& rig, Index max_poses);
 
 }  // namespace quadlod::cli

@@ -45,6 +45,11 @@ struct EvalParams {
   /// cutting a turn of up to 43.6° — just under FeatureParams::corner_angle_deg (45°), beyond
   /// which a vertex is a feature corner and cutting it moves the feature.
   double feature_tolerance = 0.2;
+  /// Hausdorff by branch and bound (src/eval/hausdorff_bound.h) when > 0: the largest distance
+  /// found and a proven upper bound at most this far above it (normalised units), from every
+  /// point of both surfaces instead of the random samples (no seed dependence). 0 (default): the
+  /// maximum over the samples and the vertices, a lower bound. `eval --animation` uses 1e-5.
+  double hausdorff_tolerance = 0.0;
   /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
   /// Results do not depend on it.
   unsigned threads = 0;
@@ -77,6 +82,17 @@ struct EvalResult {
   double hausdorff = 0.0;            ///< max(hausdorff_in_to_out, hausdorff_out_to_in)
   double hausdorff_in_to_out = 0.0;  ///< max over input samples and input vertices
   double hausdorff_out_to_in = 0.0;  ///< max over output samples and output vertices
+  /// With EvalParams::hausdorff_tolerance > 0: hausdorff* above are the branch-and-bound values
+  /// (attained distances), hausdorff_upper the proven bound on the true Hausdorff (≥ hausdorff,
+  /// within the tolerance when hausdorff_converged).
+  bool hausdorff_bounded = false;
+  bool hausdorff_converged = false;
+  double hausdorff_upper = 0.0;
+  std::uint64_t hausdorff_queries = 0;  ///< nearest-point queries of the bound, both directions
+  /// Where the bounded Hausdorff is attained, in the caller's units (not normalised), and on
+  /// which surface: true = a point of the output (out → in), false = of the input.
+  Vec3 hausdorff_point = Vec3::Zero();
+  bool hausdorff_point_on_output = false;
 
   // --- quad preservation ---------------------------------------------------------------------------
   double qpr = 0.0;                 ///< Quad Preservation Ratio (Knodt 2025), see qpr_rule

@@ -67,6 +67,11 @@ struct Scene {
   /// offset matrices as inverse bind matrices; animation channels on joints, times in seconds.
   /// Empty when no mesh is skinned.
   Rig rig;
+  /// The node whose space the skinned meshes are posed in (issue 24): FBX / Collada bind in the
+  /// skinned mesh node's space (the reader puts that node's inverse world transform in
+  /// rig.skeleton.root_transform); kInvalidIndex = world space (glTF, and scenes built in code).
+  /// The skinned .glb writer places unskinned meshes relative to it.
+  Index skin_frame_node = kInvalidIndex;
 
   std::uint64_t tri_equivalent_count() const;
   /// The world transform of node n (product of the locals from the root down).

@@ -145,6 +145,13 @@ struct SimplifyOptions {
   /// --skin-border-bones any) = any two distinct dominant joints are separated: the ram's eyes
   /// are children of its head, yet a face joining eye and head is its worst frame-by-frame error.
   std::vector<Index> skin_joint_parents;
+  /// Poses the reduction is measured in (docs/skinning.md, "Error under animation"): per pose,
+  /// the skinning matrix of every joint (G_j B_j⁻¹, skin.h). With a skinned input and poses, the
+  /// vertex quadrics that price and place every cluster are their mean over the bind pose and
+  /// these poses (src/skin/pose_quadrics.h; Mohr & Gleicher 2003), so regions the animation
+  /// bends cost more to reduce; rigidly moving regions cost the same as without. Empty = the
+  /// bind pose only. The CLI fills it from the rig's animations (--skin-poses).
+  std::vector<std::vector<Eigen::Matrix4d>> skin_poses;
 
   // --- guarantees -------------------------------------------------------------------------------
   /// Bound on the distance of moved vertices from the input, relative to the bounding-box

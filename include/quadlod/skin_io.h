@@ -27,6 +27,9 @@ struct SkinnedReadResult {
   std::string error;  ///< empty on success
   Index ignored_channels = 0;       ///< animation channels on nodes that are not joints of the skin
   Index dropped_triangles = 0;      ///< triangles with a repeated vertex after welding
+  /// Nodes of the file that hold a mesh (skinned or not); only the first skinned one is read, so
+  /// callers take a file with more than one through read_scene (scene.h) instead.
+  Index mesh_nodes = 0;
   bool ok() const { return error.empty(); }
 };
 
@@ -57,5 +60,23 @@ SkinnedReadResult read_skinned_gltf(const std::filesystem::path& path);
 /// otherwise an error. Written atomically (write_file_atomically).
 WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::filesystem::path& path,
                               const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors = {});
+
+/// One mesh of a skinned scene for write_skinned_scene_glb.
+struct SkinnedGlbMesh {
+  std::string name;
+  const PolyMesh* mesh = nullptr;  ///< skin (indexing the rig's skeleton) or none
+  /// Unskinned meshes only: where the mesh is drawn, in the space the skinned meshes are posed in
+  /// (empty = once, untransformed). Skinned meshes are drawn once, where their joints put them.
+  std::vector<Eigen::Matrix4d> placements;
+};
+
+/// Several meshes on one skeleton (issue 24): every mesh with weights becomes a skinned mesh node
+/// with its own skin, all skins on the same joint nodes and inverse bind matrices; meshes without
+/// weights become plain nodes (one per placement); materials are shared by name. Otherwise as
+/// write_skinned_glb (which is this with one mesh named "lod"). Errors: a mesh that fails
+/// check_layout() or names a joint the skeleton lacks, no mesh with weights, an invalid skeleton.
+WriteResult write_skinned_scene_glb(const std::vector<SkinnedGlbMesh>& meshes, const Rig& rig,
+                                    const std::filesystem::path& path,
+                                    const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors = {});
 
 }  // namespace quadlod

@@ -24,6 +24,20 @@ std::string check_skin(const PolyMesh& mesh, const Skeleton& skeleton, const cha
 
 double json_number(double v) { return v; }
 
+/// The largest-weight joint of the vertex nearest to p (a linear scan: one query per frame).
+Index dominant_joint_near(const PolyMesh& mesh, const Vec3& p) {
+  Index best = kInvalidIndex;
+  double best_d2 = INFINITY;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const double d2 = (mesh.positions[v] - p).squaredNorm();
+    if (d2 < best_d2 && mesh.skin.influences(v) > 0) {
+      best_d2 = d2;
+      best = v;
+    }
+  }
+  return best == kInvalidIndex ? kInvalidIndex : mesh.skin.joint[mesh.skin.offsets[best]];
+}
+
 }  // namespace
 
 FrameSummary summarise_frames(const std::vector<AnimationFrame>& frames, double (*metric)(const EvalResult&)) {
@@ -79,11 +93,13 @@ AnimationEvalResult evaluate_animation(const PolyMesh& input, const PolyMesh& ou
         skinning_matrices(rig.skeleton, global_joint_matrices(rig.skeleton, sample_pose(rig.skeleton, anim, times[f])));
     AnimationFrame frame;
     frame.time = times[f];
-    frame.metrics = evaluate(pose_mesh(input, m), pose_mesh(output, m), params.metrics);
+    const PolyMesh posed_input = pose_mesh(input, m);
+    frame.metrics = evaluate(posed_input, pose_mesh(output, m), params.metrics);
     if (!frame.metrics.ok()) {
       result.error = "frame " + std::to_string(f) + " (t = " + std::to_string(times[f]) + " s): " + frame.metrics.error;
       return result;
     }
+    if (frame.metrics.hausdorff_bounded) frame.hausdorff_joint = dominant_joint_near(posed_input, frame.metrics.hausdorff_point);
     result.frames.push_back(std::move(frame));
   }
   result.pccd = summarise_frames(result.frames, [](const EvalResult& r) { return r.pccd_defined ? r.pccd : std::nan(""); });
@@ -94,10 +110,10 @@ AnimationEvalResult evaluate_animation(const PolyMesh& input, const PolyMesh& ou
   return result;
 }
 
-nlohmann::json to_json(const AnimationEvalResult& r) {
+nlohmann::json to_json(const AnimationEvalResult& r, const Skeleton* skeleton) {
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(json_number(v)) : nlohmann::json(); };
   nlohmann::json frames = nlohmann::json::array();
-  for (const AnimationFrame& f : r.frames)
+  for (const AnimationFrame& f : r.frames) {
     frames.push_back({{"time", f.time},
                       {"pccd", f.metrics.pccd_defined ? num(f.metrics.pccd) : nlohmann::json()},
                       {"chamfer", num(f.metrics.chamfer)},
@@ -107,6 +123,19 @@ nlohmann::json to_json(const AnimationEvalResult& r) {
                       {"flow_deviation_deg", num(f.metrics.flow_deviation_deg)},
                       {"flow_coverage", num(f.metrics.flow_coverage)},
                       {"flipped_faces", f.metrics.flipped_faces}});
+    if (f.metrics.hausdorff_bounded) {
+      nlohmann::json& j = frames.back();
+      j["hausdorff_upper"] = num(f.metrics.hausdorff_upper);
+      j["hausdorff_converged"] = f.metrics.hausdorff_converged;
+      const Vec3& p = f.metrics.hausdorff_point;
+      j["hausdorff_point"] = {p.x(), p.y(), p.z()};
+      j["hausdorff_on"] = f.metrics.hausdorff_point_on_output ? "output" : "input";
+      if (f.hausdorff_joint != kInvalidIndex)
+        j["hausdorff_joint"] = skeleton && f.hausdorff_joint < skeleton->num_joints()
+                                   ? nlohmann::json(skeleton->joints[f.hausdorff_joint].name)
+                                   : nlohmann::json(f.hausdorff_joint);
+    }
+  }
   auto summary = [&](const FrameSummary& s) {
     return nlohmann::json{{"median", num(s.median)},
                           {"worst", num(s.worst)},

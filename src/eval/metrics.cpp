@@ -19,6 +19,7 @@
 // feature_metrics.cpp; what both files share is in metrics_common.h.
 #include "quadlod/metrics.h"
 
+#include "eval/hausdorff_bound.h"
 #include "eval/metrics_common.h"
 #include "geometry/bvh.h"
 #include "geometry/sampling.h"
@@ -347,6 +348,23 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
   r.hausdorff_in_to_out = d_in.max;
   r.hausdorff_out_to_in = d_out.max;
   r.hausdorff = std::max(d_in.max, d_out.max);
+  if (params.hausdorff_tolerance > 0.0) {
+    eval_detail::HausdorffBoundParams hp;
+    hp.tolerance = params.hausdorff_tolerance;
+    eval_detail::HausdorffBound b_in, b_out;
+    run_both(
+        threads, [&] { b_in = eval_detail::directed_hausdorff_bound(soup_in.triangles, bvh_out, soup_out.triangles, hp); },
+        [&] { b_out = eval_detail::directed_hausdorff_bound(soup_out.triangles, bvh_in, soup_in.triangles, hp); });
+    r.hausdorff_bounded = true;
+    r.hausdorff_converged = b_in.converged && b_out.converged;
+    r.hausdorff_in_to_out = b_in.lower;
+    r.hausdorff_out_to_in = b_out.lower;
+    r.hausdorff = std::max(b_in.lower, b_out.lower);
+    r.hausdorff_upper = std::max(b_in.upper, b_out.upper);
+    r.hausdorff_queries = b_in.queries + b_out.queries;
+    r.hausdorff_point_on_output = b_out.lower > b_in.lower;
+    r.hausdorff_point = (r.hausdorff_point_on_output ? b_out.at : b_in.at) / r.scale + centre;
+  }
   r.seconds_distance = seconds_since(t_dist);
 
   // §6b orientation: an output face is flipped when the nearest input surface that faces its way
@@ -505,6 +523,11 @@ nlohmann::json to_json(const EvalResult& r) {
   j["hausdorff"] = num(r.hausdorff);
   j["hausdorff_in_to_out"] = num(r.hausdorff_in_to_out);
   j["hausdorff_out_to_in"] = num(r.hausdorff_out_to_in);
+  if (r.hausdorff_bounded) {  // only then, so the JSON of a default eval does not change
+    j["hausdorff_upper"] = num(r.hausdorff_upper);
+    j["hausdorff_converged"] = r.hausdorff_converged;
+    j["hausdorff_queries"] = r.hausdorff_queries;
+  }
   j["qpr"] = num(r.qpr);
   j["qpr_rule"] = r.qpr_rule;
   j["quad_fraction_in"] = num(r.quad_fraction_in);

@@ -536,6 +536,7 @@ class SceneBuilder {
         for (Index m : scene_.nodes[n].meshes) skinned |= !scene_.meshes[m].mesh.skin.empty();
         if (!skinned) continue;
         sk.root_transform = scene_.world_transform(n).inverse() * sk.root_transform;
+        scene_.skin_frame_node = n;
         break;
       }
     }

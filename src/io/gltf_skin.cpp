@@ -225,6 +225,7 @@ SkinnedReadResult read_impl(const std::filesystem::path& path) {
       break;
     }
   if (mesh_node == SIZE_MAX) doc.fail("no node has both a mesh and a skin");
+  for (std::size_t n = 0; n < num_nodes; ++n) result.mesh_nodes += g["nodes"][n].contains("mesh") ? 1 : 0;
   const json& skin = doc.at("skins", g["nodes"][mesh_node]["skin"].get<std::size_t>());
   const json& gmesh = doc.at("meshes", g["nodes"][mesh_node]["mesh"].get<std::size_t>());
 

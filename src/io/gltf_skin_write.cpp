@@ -2,7 +2,9 @@
 //
 //   scene ── node 0 "rig" (matrix = Skeleton::root_transform)
 //              ├── joint nodes (TRS rest pose, the skeleton's hierarchy)
-//              └── mesh node (mesh 0, skin 0; no transform: glTF ignores it for skinned meshes)
+//              └── one node per skinned mesh (mesh k, skin k; no transform: glTF ignores it for
+//                  skinned meshes; every skin lists the same joints and inverse bind matrices)
+//   scene ── one node per placement of an unskinned mesh (matrix = its transform)
 //
 // One primitive per material; a glTF vertex per distinct (vertex, UV, normal) corner of that
 // material's faces; polygons as fans (glTF has triangles only, §3.7.2.1). Every array goes into
@@ -76,22 +78,30 @@ void put_u32(std::string& s, std::uint32_t v) {
   s.append(b, 4);
 }
 
-}  // namespace
+/// Materials of the file, shared by name between the meshes (slots in order of first use).
+struct MaterialTable {
+  json materials = json::array();
+  std::map<std::string, std::size_t> slot;
+  std::size_t of(const std::string& mname, const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors) {
+    if (const auto it = slot.find(mname); it != slot.end()) return it->second;
+    Eigen::Vector4d color(0.8, 0.8, 0.8, 1.0);
+    for (const auto& [n, c] : material_colors)
+      if (n == mname) color = c;
+    materials.push_back({{"name", mname},
+                         {"doubleSided", true},
+                         {"pbrMetallicRoughness",
+                          {{"baseColorFactor", {color[0], color[1], color[2], color[3]}},
+                           {"metallicFactor", 0.0},
+                           {"roughnessFactor", 1.0}}}});
+    return slot[mname] = materials.size() - 1;
+  }
+};
 
-WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::filesystem::path& path,
-                              const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors) {
-  WriteResult result;
-  const std::string name = path.string();
-  if (std::string p = mesh.check_layout(); !p.empty()) return {name + ": " + p, {}};
-  if (std::string p = rig.skeleton.check(); !p.empty()) return {name + ": " + p, {}};
-  if (mesh.skin.empty()) return {name + ": the mesh has no skin weights", {}};
-  const Index num_joints = rig.skeleton.num_joints();
-  for (Index j : mesh.skin.joint)
-    if (j >= num_joints) return {name + ": a weight names joint " + std::to_string(j) + " of " + std::to_string(num_joints), {}};
-  if (num_joints > 65535) return {name + ": more than 65535 joints", {}};
-
-  BinaryBuilder b;
-  const Index sets = std::max<Index>(1, (mesh.skin.max_influences() + 3) / 4);
+/// The glTF primitives of one mesh: one per material; JOINTS_n / WEIGHTS_n when it has weights.
+json mesh_primitives(const PolyMesh& mesh, BinaryBuilder& b, MaterialTable& table,
+                     const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors) {
+  const bool skinned = !mesh.skin.empty();
+  const Index sets = skinned ? std::max<Index>(1, (mesh.skin.max_influences() + 3) / 4) : 0;
   const bool uvs = mesh.has_uvs();
   const bool normals = mesh.has_normals();
   // Faces by material (kInvalidIndex = none), in the order materials are named.
@@ -99,8 +109,6 @@ WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::f
   for (Index f = 0; f < mesh.num_faces(); ++f)
     faces_of[mesh.face_material.empty() ? kInvalidIndex : mesh.face_material[f]].push_back(f);
 
-  json materials = json::array();
-  std::map<Index, std::size_t> material_slot;
   json primitives = json::array();
   for (const auto& [material, faces] : faces_of) {
     std::map<std::tuple<Index, Index, Index>, std::uint32_t> vertex_of;
@@ -127,6 +135,7 @@ WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::f
           tex.push_back(static_cast<float>(1.0 - t.y()));  // glTF's origin is the top left
         }
         // Influences in sets of four, renormalised in float (the glTF validator's tolerance).
+        if (!skinned) return it->second;
         std::vector<float> w(4 * sets, 0.0f);
         std::vector<std::uint16_t> j(4 * sets, 0);
         float sum = 0.0f;
@@ -172,22 +181,51 @@ WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::f
     prim["extras"] = {{"quadlod_polygon_sizes", b.u32(polygon_sizes, 0)}};
     if (material != kInvalidIndex) {
       const std::string mname = material < mesh.material_names.size() ? mesh.material_names[material] : "material";
-      Eigen::Vector4d color(0.8, 0.8, 0.8, 1.0);
-      for (const auto& [n, c] : material_colors)
-        if (n == mname) color = c;
-      material_slot[material] = materials.size();
-      materials.push_back({{"name", mname},
-                           {"doubleSided", true},
-                           {"pbrMetallicRoughness",
-                            {{"baseColorFactor", {color[0], color[1], color[2], color[3]}},
-                             {"metallicFactor", 0.0},
-                             {"roughnessFactor", 1.0}}}});
-      prim["material"] = material_slot[material];
+      prim["material"] = table.of(mname, material_colors);
     }
     primitives.push_back(prim);
   }
+  return primitives;
+}
 
-  // Nodes: 0 the rig root, 1 + j the joints, 1 + J the mesh.
+std::string check_skinned_mesh(const PolyMesh& mesh, Index num_joints) {
+  if (std::string p = mesh.check_layout(); !p.empty()) return p;
+  for (Index j : mesh.skin.joint)
+    if (j >= num_joints) return "a weight names joint " + std::to_string(j) + " of " + std::to_string(num_joints);
+  return {};
+}
+
+}  // namespace
+
+WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::filesystem::path& path,
+                              const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors) {
+  if (mesh.skin.empty()) return {path.string() + ": the mesh has no skin weights", {}};
+  return write_skinned_scene_glb({SkinnedGlbMesh{"lod", &mesh, {}}}, rig, path, material_colors);
+}
+
+WriteResult write_skinned_scene_glb(const std::vector<SkinnedGlbMesh>& meshes, const Rig& rig,
+                                    const std::filesystem::path& path,
+                                    const std::vector<std::pair<std::string, Eigen::Vector4d>>& material_colors) {
+  const std::string name = path.string();
+  if (std::string p = rig.skeleton.check(); !p.empty()) return {name + ": " + p, {}};
+  const Index num_joints = rig.skeleton.num_joints();
+  if (num_joints > 65535) return {name + ": more than 65535 joints", {}};
+  bool any_skin = false;
+  for (const SkinnedGlbMesh& m : meshes) {
+    if (!m.mesh) return {name + ": mesh '" + m.name + "' is missing", {}};
+    if (std::string p = check_skinned_mesh(*m.mesh, num_joints); !p.empty())
+      return {name + ": mesh '" + m.name + "': " + p, {}};
+    any_skin |= !m.mesh->skin.empty();
+  }
+  if (!any_skin) return {name + ": no mesh has skin weights", {}};
+
+  BinaryBuilder b;
+  MaterialTable table;
+  json gltf_meshes = json::array();
+  for (const SkinnedGlbMesh& m : meshes)
+    gltf_meshes.push_back({{"name", m.name}, {"primitives", mesh_primitives(*m.mesh, b, table, material_colors)}});
+
+  // Nodes: 0 the rig root, 1 + j the joints, then the skinned meshes' nodes, then the others.
   const Skeleton& sk = rig.skeleton;
   json nodes = json::array();
   json root = {{"name", "rig"}, {"children", json::array()}};
@@ -219,12 +257,35 @@ WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::f
       nodes[1 + p]["children"].push_back(1 + j);
     }
   }
-  nodes[0]["children"].push_back(1 + num_joints);
-  nodes.push_back({{"name", "lod"}, {"mesh", 0}, {"skin", 0}});
   json joint_nodes = json::array();
   for (Index j = 0; j < num_joints; ++j) joint_nodes.push_back(1 + j);
   json skin = {{"joints", joint_nodes}, {"inverseBindMatrices", b.floats(ibm, 16, "MAT4", 0, false)}};
   if (first_root != kInvalidIndex) skin["skeleton"] = 1 + first_root;
+  json skins = json::array();
+  json scene_nodes = json::array({0});
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    if (meshes[k].mesh->skin.empty()) continue;
+    // Each skinned mesh its own skin (glTF: one skin per skinned mesh node is what importers
+    // expect), all on the same joints and inverse bind matrices.
+    nodes[0]["children"].push_back(nodes.size());
+    nodes.push_back({{"name", meshes[k].name}, {"mesh", k}, {"skin", skins.size()}});
+    skins.push_back(skin);
+  }
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    if (!meshes[k].mesh->skin.empty()) continue;
+    const std::vector<Eigen::Matrix4d> placements =
+        meshes[k].placements.empty() ? std::vector<Eigen::Matrix4d>{Eigen::Matrix4d::Identity()} : meshes[k].placements;
+    for (const Eigen::Matrix4d& m : placements) {
+      json node = {{"name", meshes[k].name}, {"mesh", k}};
+      if (!m.isIdentity(0.0)) {
+        std::vector<double> v(16);
+        for (int i = 0; i < 16; ++i) v[i] = m(i % 4, i / 4);
+        node["matrix"] = v;
+      }
+      scene_nodes.push_back(nodes.size());
+      nodes.push_back(node);
+    }
+  }
 
   json animations = json::array();
   for (const Animation& anim : rig.animations) {
@@ -251,14 +312,14 @@ WriteResult write_skinned_glb(const PolyMesh& mesh, const Rig& rig, const std::f
   while (b.bin.size() % 4) b.bin.push_back('\0');
   json gltf = {{"asset", {{"version", "2.0"}, {"generator", "quadlod"}}},
                {"scene", 0},
-               {"scenes", {{{"nodes", {0}}}}},
+               {"scenes", {{{"nodes", scene_nodes}}}},
                {"nodes", nodes},
-               {"meshes", {{{"name", "lod"}, {"primitives", primitives}}}},
-               {"skins", {skin}},
+               {"meshes", gltf_meshes},
+               {"skins", skins},
                {"accessors", b.accessors},
                {"bufferViews", b.buffer_views},
                {"buffers", {{{"byteLength", b.bin.size()}}}}};
-  if (!materials.empty()) gltf["materials"] = materials;
+  if (!table.materials.empty()) gltf["materials"] = table.materials;
   if (!animations.empty()) gltf["animations"] = animations;
   std::string text = gltf.dump();
   while (text.size() % 4) text.push_back(' ');

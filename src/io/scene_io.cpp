@@ -1,6 +1,7 @@
 // quadlod — read_scene / write_scene (include/quadlod/scene.h): the choice by extension
 // between the native OBJ / PLY / OFF code (io.h) and assimp, and scene flattening.
 #include "io/assimp_detail.h"
+#include "io/scene_skin_write.h"
 #include "quadlod/scene.h"
 
 #include <algorithm>
@@ -195,6 +196,8 @@ WriteResult write_scene(const Scene& scene, const std::filesystem::path& path, c
     }
     return one_mesh ? write_mesh(scene.meshes[0].mesh, path, options) : write_mesh(flatten_scene(scene), path, options);
   }
+  // Issue 24: assimp's glTF exporter writes no skin; a skinned scene goes to quadlod's own.
+  if (format == SceneFormat::Glb && io_detail::scene_is_skinned(scene)) return io_detail::write_skinned_scene(scene, path);
   const char* id = format == SceneFormat::Glb ? "glb2" : format == SceneFormat::Fbx ? "fbx" : "collada";
   std::string bytes, error;
   if (!io_detail::format_scene_with_assimp(scene, id, format == SceneFormat::Glb, bytes, error)) {

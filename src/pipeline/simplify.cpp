@@ -11,6 +11,7 @@
 #include "select/selection.h"
 #include "select/shape_selection.h"
 #include "skin/skin_borders.h"
+#include "skin/pose_quadrics.h"
 #include "quadlod/skin.h"
 #include "topology/analysis.h"
 #include "util/progress.h"
@@ -232,7 +233,10 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ClusterCollapseParams pass_cp = cp;
   // The vertex quadrics of this pass's input, once for the shape selection and every collapse
   // round (geometry/cluster_quadric.h: the placement both use).
-  const VertexQuadrics quadrics = build_vertex_quadrics(input, conn, cp.placement);
+  // With skin and poses (issue 24), measured in every pose (skin/pose_quadrics.h).
+  const VertexQuadrics quadrics = input.skin.empty() || options.skin_poses.empty()
+                                      ? build_vertex_quadrics(input, conn, cp.placement)
+                                      : build_pose_vertex_quadrics(input, conn, cp.placement, options.skin_poses);
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
   if (options.features) {
