@@ -179,6 +179,15 @@ TEST(Simplify, DecisionsAreOnFloat32SoTheStoragePrecisionDoesNotMatter) {
     EXPECT_LT((p - q).norm(), 1e-6) << v;
   }
   EXPECT_GT(kept, 10u);  // 27 of 368 at this ratio: the rest were merged
+  // In place: the same output bytes, and the input is given back unchanged.
+  PolyMesh own = vase;
+  const SimplifyResult c = simplify_in_place(own, o);
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ(own.positions, vase.positions);
+  EXPECT_EQ(own.uv_sets[0].values, vase.uv_sets[0].values);
+  EXPECT_EQ(c.mesh.positions, a.mesh.positions);
+  EXPECT_EQ(c.mesh.corner_vertex, a.mesh.corner_vertex);
+  EXPECT_EQ(c.mesh.uv_sets[0].values, a.mesh.uv_sets[0].values);
   // Deciding on the doubles is still there.
   o.float32_decisions = false;
   EXPECT_FALSE(simplify(vase, o).report.contains("float32_decisions"));

@@ -253,7 +253,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
               for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             if (!in.mesh.skin.empty()) p.skin_poses = rig_poses(in.rig, opt->skin_poses);
             const double read_seconds = clock.seconds();
-            SimplifyResult r = simplify(in.mesh, p);
+            SimplifyResult r = simplify_in_place(in.mesh, p);  // the input is ours: no copy of it
             if (!r.ok()) return fail(opt->input + ": " + r.error);
             // The output may live elsewhere: keep its `mtllib` lines pointing at the input's MTL.
             for (const std::string& w : rebase_material_libraries(r.mesh, opt->input, opt->output))

@@ -877,4 +877,15 @@ SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
   return result;
 }
 
+SimplifyResult simplify_in_place(PolyMesh& input, const SimplifyOptions& options) {
+  if (!options.float32_decisions) return simplify_on(input, options);
+  std::optional<PolyMesh> exact = round_to_float32_in_place(input);
+  if (!exact) return simplify_on(input, options);
+  SimplifyResult result = simplify_on(input, options);
+  put_back_exact_values(std::move(*exact), input);
+  if (result.ok()) restore_input_values(input, result.mesh);
+  result.report["float32_decisions"] = true;
+  return result;
+}
+
 }  // namespace quadlod

@@ -69,6 +69,13 @@ void round_all(std::vector<V>& values) {
   for (V& p : values) p = rounded(p);
 }
 
+bool roundable(const PolyMesh& mesh, bool& changes) {
+  if (!check(mesh.positions, changes) || !check(mesh.normals, changes)) return false;
+  for (const UvSet& set : mesh.uv_sets)
+    if (!check(set.values, changes)) return false;
+  return true;
+}
+
 // Values of `output` that are exactly a rounded value of `input` get that input value back.
 template <class V>
 void restore(const std::vector<V>& input, std::vector<V>& output) {
@@ -86,15 +93,33 @@ void restore(const std::vector<V>& input, std::vector<V>& output) {
 
 std::optional<PolyMesh> with_float32_attributes(const PolyMesh& mesh) {
   bool changes = false;
-  if (!check(mesh.positions, changes) || !check(mesh.normals, changes)) return std::nullopt;
-  for (const UvSet& set : mesh.uv_sets)
-    if (!check(set.values, changes)) return std::nullopt;
-  if (!changes) return std::nullopt;
+  if (!roundable(mesh, changes) || !changes) return std::nullopt;
   PolyMesh out = mesh;
   round_all(out.positions);
   round_all(out.normals);
   for (UvSet& set : out.uv_sets) round_all(set.values);
   return out;
+}
+
+std::optional<PolyMesh> round_to_float32_in_place(PolyMesh& mesh) {
+  bool changes = false;
+  if (!roundable(mesh, changes) || !changes) return std::nullopt;
+  PolyMesh exact;
+  exact.positions = mesh.positions;
+  exact.normals = mesh.normals;
+  exact.uv_sets.resize(mesh.uv_sets.size());
+  for (std::size_t k = 0; k < mesh.uv_sets.size(); ++k) exact.uv_sets[k].values = mesh.uv_sets[k].values;
+  round_all(mesh.positions);
+  round_all(mesh.normals);
+  for (UvSet& set : mesh.uv_sets) round_all(set.values);
+  return exact;
+}
+
+void put_back_exact_values(PolyMesh&& exact, PolyMesh& mesh) {
+  mesh.positions = std::move(exact.positions);
+  mesh.normals = std::move(exact.normals);
+  for (std::size_t k = 0; k < mesh.uv_sets.size() && k < exact.uv_sets.size(); ++k)
+    mesh.uv_sets[k].values = std::move(exact.uv_sets[k].values);
 }
 
 void restore_input_values(const PolyMesh& input, PolyMesh& output) {

@@ -19,6 +19,14 @@ namespace quadlod {
 /// or not finite: then decisions stay on the doubles, and validation reports the latter).
 std::optional<PolyMesh> with_float32_attributes(const PolyMesh& mesh);
 
+/// Rounds `mesh`'s positions, normals and UVs to float32 in place, returning their exact values
+/// (a mesh holding only positions, normals and UV values) — or nothing, and `mesh` unchanged,
+/// in the cases where with_float32_attributes() gives nothing.
+std::optional<PolyMesh> round_to_float32_in_place(PolyMesh& mesh);
+
+/// Puts the values taken by round_to_float32_in_place() back.
+void put_back_exact_values(PolyMesh&& exact, PolyMesh& mesh);
+
 /// Every position (normal, UV) of `output` that is exactly a rounded value of `input` gets that
 /// input value back (the lowest-numbered one where several round to the same): unmoved vertices,
 /// clusters placed at a member, kept UVs and normals.
