@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 #include <string>
@@ -126,6 +127,16 @@ inline std::string corpus_file(const std::string& name) {
   if (fs::exists(p)) return p.string();
 #endif
   return {};
+}
+
+/// The bytes write_mesh() gives `mesh` as an OBJ (through a temp file named after `tag`): what
+/// the determinism tests compare.
+inline std::string obj_bytes(const PolyMesh& mesh, const std::string& tag) {
+  TempDir dir;
+  const fs::path path = dir.path() / (tag + ".obj");
+  EXPECT_TRUE(write_mesh(mesh, path.string()).ok());
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 }  // namespace quadlod::io_test

@@ -6,6 +6,7 @@
 #include "quadlod/io.h"
 #include "quadlod/simplify.h"
 #include "topology/analysis.h"
+#include "io_test_util.h"
 #include "prepared_mesh.h"
 
 #include "util/stage_log.h"
@@ -232,13 +233,7 @@ TEST(ShapeSelection, OutputBytesDoNotDependOnThreads) {
     options.threads = threads;
     const SimplifyResult r = simplify(vase, options);
     EXPECT_TRUE(r.ok()) << r.error;
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("quadlod_shape_threads_" + std::to_string(threads) + "_" + std::to_string(::getpid()) + ".obj");
-    EXPECT_TRUE(write_mesh(r.mesh, path.string()).ok());
-    std::ifstream in(path, std::ios::binary);
-    std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::filesystem::remove(path);
-    return data;
+    return io_test::obj_bytes(r.mesh, "shape_threads_" + std::to_string(threads));
   };
   const std::string one = bytes(1);
   EXPECT_FALSE(one.empty());

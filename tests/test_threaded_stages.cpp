@@ -10,6 +10,8 @@
 #include "topology/polychords.h"
 #include "topology/segmentation.h"
 
+#include "io_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -97,13 +99,7 @@ TEST(ThreadedStages, SimplifyWithUvsAndNormalsGivesTheSameBytes) {
     EXPECT_TRUE(r.ok()) << r.error;
     EXPECT_GT(r.report["collapse"]["uv_values_projected"].get<long>(), 0);
     EXPECT_GT(r.report["collapse"]["normals_recomputed"].get<long>(), 0);
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("quadlod_threaded_" + std::to_string(threads * 1000000 + ::getpid() % 1000000) + ".obj");
-    EXPECT_TRUE(write_mesh(r.mesh, path.string()).ok());
-    std::ifstream in(path, std::ios::binary);
-    std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::filesystem::remove(path);
-    return data;
+    return io_test::obj_bytes(r.mesh, "threaded_" + std::to_string(threads));
   };
   const std::string one = bytes(1);
   EXPECT_NE(one.find("\nvn "), std::string::npos);

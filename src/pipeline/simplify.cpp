@@ -867,14 +867,9 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
 // from its FBX or glTF (src/pipeline/storage_precision.h); what did not move keeps the input's own
 // values.
 SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
-  if (!options.float32_decisions) return simplify_on(input, options);
-  std::optional<PolyMesh> rounded = with_float32_attributes(input);
-  if (!rounded) return simplify_on(input, options);
-  SimplifyResult result = simplify_on(*rounded, options);
-  rounded.reset();
-  if (result.ok()) restore_input_values(input, result.mesh);
-  result.report["float32_decisions"] = true;  // the values were rounded for the decisions
-  return result;
+  if (!options.float32_decisions || !float32_rounding_changes(input)) return simplify_on(input, options);
+  PolyMesh own = input;  // rounded in place below, its exact values put back
+  return simplify_in_place(own, options);
 }
 
 SimplifyResult simplify_in_place(PolyMesh& input, const SimplifyOptions& options) {

@@ -91,19 +91,13 @@ void restore(const std::vector<V>& input, std::vector<V>& output) {
 
 }  // namespace
 
-std::optional<PolyMesh> with_float32_attributes(const PolyMesh& mesh) {
+bool float32_rounding_changes(const PolyMesh& mesh) {
   bool changes = false;
-  if (!roundable(mesh, changes) || !changes) return std::nullopt;
-  PolyMesh out = mesh;
-  round_all(out.positions);
-  round_all(out.normals);
-  for (UvSet& set : out.uv_sets) round_all(set.values);
-  return out;
+  return roundable(mesh, changes) && changes;
 }
 
 std::optional<PolyMesh> round_to_float32_in_place(PolyMesh& mesh) {
-  bool changes = false;
-  if (!roundable(mesh, changes) || !changes) return std::nullopt;
+  if (!float32_rounding_changes(mesh)) return std::nullopt;
   PolyMesh exact;
   exact.positions = mesh.positions;
   exact.normals = mesh.normals;

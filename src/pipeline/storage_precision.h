@@ -14,14 +14,14 @@
 
 namespace quadlod {
 
-/// `mesh` with every position, normal and UV rounded to the nearest float32, or nothing when that
-/// changes no value (already float32 values) or cannot be done (a value beyond float32's range,
-/// or not finite: then decisions stay on the doubles, and validation reports the latter).
-std::optional<PolyMesh> with_float32_attributes(const PolyMesh& mesh);
+/// True when rounding `mesh`'s positions, normals and UVs to float32 changes one of them and can
+/// be done (no value beyond float32's range or not finite: then decisions stay on the doubles,
+/// and validation reports the latter).
+bool float32_rounding_changes(const PolyMesh& mesh);
 
 /// Rounds `mesh`'s positions, normals and UVs to float32 in place, returning their exact values
 /// (a mesh holding only positions, normals and UV values) — or nothing, and `mesh` unchanged,
-/// in the cases where with_float32_attributes() gives nothing.
+/// when float32_rounding_changes() is false.
 std::optional<PolyMesh> round_to_float32_in_place(PolyMesh& mesh);
 
 /// Puts the values taken by round_to_float32_in_place() back.
