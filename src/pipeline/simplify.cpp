@@ -14,6 +14,7 @@
 #include "skin/pose_quadrics.h"
 #include "quadlod/skin.h"
 #include "topology/analysis.h"
+#include "util/parallel.h"
 #include "util/progress.h"
 #include "util/stage_log.h"
 
@@ -196,7 +197,9 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   PassOutcome out;
   nlohmann::json& report = out.report;
 
-  // 1. Connectivity and analysis (§3.1, §3.2.2–§3.2.4).
+  // 1. Connectivity and analysis (§3.1, §3.2.2–§3.2.4); beside the analysis, on a second
+  // thread, the vertex quadrics and the feature lines, which need only the mesh and its
+  // connectivity (issue 20: they were a third of a pass's set-up, one after the other).
   Stopwatch clock;
   const Connectivity conn = build_connectivity(input);
   AnalysisParams ap;
@@ -204,8 +207,29 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ap.segmentation.epsilon_theta = options.epsilon_theta_deg * std::numbers::pi / 180.0;
   ap.segmentation.threads = options.threads;
   ap.clusters = options.objective == "paper";
-  const AnalysisResult analysis = analyze(input, conn, ap);
-  out.seconds_analysis = clock.seconds();
+  AnalysisResult analysis;
+  // The vertex quadrics of this pass's input, once for the shape selection and every collapse
+  // round (geometry/cluster_quadric.h: the placement both use).
+  // With skin and poses (issue 24), measured in every pose (skin/pose_quadrics.h).
+  VertexQuadrics quadrics;
+  std::optional<FeatureEdges> feat;  // computed once per pass: pins here, the collapse's rules
+  double seconds_features = 0.0;
+  run_beside(
+      options.threads, input.num_faces() >= options.min_faces_beside,
+      [&] {
+        analysis = analyze(input, conn, ap);
+        out.seconds_analysis = clock.seconds();
+      },
+      [&] {
+        quadrics = input.skin.empty() || options.skin_poses.empty()
+                       ? build_vertex_quadrics(input, conn, cp.placement)
+                       : build_pose_vertex_quadrics(input, conn, cp.placement, options.skin_poses);
+        if (options.features) {
+          const Stopwatch features_clock;
+          feat = find_feature_edges(input, conn, cp.features);
+          seconds_features = features_clock.seconds();
+        }
+      });
   report["analysis"] = {
       {"seconds", out.seconds_analysis},
       {"polychords", analysis.polychords.chords.size()},
@@ -229,19 +253,10 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   const bool reducing = target < out.input_tri_equivalent;
   const int max_rounds = reducing ? std::max(1, options.max_rounds) : 1;
   std::vector<std::uint8_t> pinned;
-  std::optional<FeatureEdges> feat;  // computed once per pass: pins here, the collapse's rules
   ClusterCollapseParams pass_cp = cp;
-  // The vertex quadrics of this pass's input, once for the shape selection and every collapse
-  // round (geometry/cluster_quadric.h: the placement both use).
-  // With skin and poses (issue 24), measured in every pose (skin/pose_quadrics.h).
-  const VertexQuadrics quadrics = input.skin.empty() || options.skin_poses.empty()
-                                      ? build_vertex_quadrics(input, conn, cp.placement)
-                                      : build_pose_vertex_quadrics(input, conn, cp.placement, options.skin_poses);
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
   if (options.features) {
-    clock = Stopwatch();
-    feat = find_feature_edges(input, conn, cp.features);
     pinned = feature_pins(conn, *feat, out.feature_pins);
     pass_cp.feature_edges = &*feat;
     report["features"] = {
@@ -255,7 +270,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         {"lines", feat->num_lines},
         {"corners", feat->corners},
         {"pinned_edges", out.feature_pins},
-        {"seconds", clock.seconds()},
+        {"seconds", seconds_features},
     };
   }
   // Joint-influence borders (issue 24, docs/skinning.md): kept like the feature pins.

@@ -132,12 +132,9 @@ class ShapeState {
     if (!params.vertex_quadrics) own_quadrics_ = build_vertex_quadrics(mesh, conn, params.placement);
     quadrics_ = params.vertex_quadrics ? params.vertex_quadrics : &own_quadrics_;
     h_ = quadrics_->mean_edge;
-    // Per-vertex and per-face set-up on all threads: every item is written by one chunk and the
-    // sums below run in item order, so the state is the same for any thread count.
-    terms_.resize(nv);
-    parallel_chunks(std::size_t(nv), params.threads, params.min_parallel_candidates, [&](std::size_t b, std::size_t e, std::size_t) {
-      for (std::size_t v = b; v < e; ++v) terms_[v] = vertex_alone(Index(v));
-    });
+    // Per-face set-up on all threads: every item is written by one chunk and the sums below run
+    // in item order, so the state is the same for any thread count.
+    slot_.assign(nv, kInvalidIndex);  // every vertex alone: its terms come from the quadrics
     err_.assign(nv, 0.0);  // a lone vertex sits on all of its planes
     pos_ = mesh.positions;
     next_member_.resize(nv);
@@ -206,7 +203,7 @@ class ShapeState {
         sc.add_set();
       }
       NewCluster& s = sc.sets[sc.set_of[r]];
-      s.terms += terms_[sc.locals[i]];
+      add_terms_of(sc.locals[i], s.terms);
       s.roots.push_back(sc.locals[i]);
       m.error -= err_[sc.locals[i]];
     }
@@ -287,7 +284,8 @@ class ShapeState {
     count_ -= m.reduced;
     for (Index r : split_roots_) {
       m.error -= err_[r];
-      if (terms_[r].w > 0.0) m.peak2 = std::max(m.peak2, err_[r] / terms_[r].w);
+      const double w = slot_[r] == kInvalidIndex ? quadrics_->terms[r].w : pool_[slot_[r]].w;
+      if (w > 0.0) m.peak2 = std::max(m.peak2, err_[r] / w);
       for_each_member(r, [&](Index v) { split_members_.push_back(v); });
     }
     gather_faces(sc, [&](auto&& visit) {
@@ -296,7 +294,7 @@ class ShapeState {
     for (Index v : split_members_) {
       uf_.reset(v);
       next_member_[v] = v;
-      terms_[v] = vertex_alone(v);
+      drop_terms(v);
       err_[v] = 0.0;
       pos_[v] = mesh_.positions[v];
     }
@@ -309,11 +307,13 @@ class ShapeState {
           const auto [a, b] = conn_.edge_vertices[e];
           const Index ra = uf_.find(a), rb = uf_.find(b);
           if (ra == rb) continue;
-          ClusterTerms t = terms_[ra];
-          t += terms_[rb];
+          ClusterTerms t = slot_[ra] == kInvalidIndex ? vertex_alone(ra) : pool_[slot_[ra]];
+          add_terms_of(rb, t);
           std::swap(next_member_[ra], next_member_[rb]);
           const Index r = uf_.unite(ra, rb);
-          terms_[r] = t;
+          drop_terms(ra);
+          drop_terms(rb);
+          set_terms(r, t);
         }
     ++sc.token;
     for (Index v : split_members_) {
@@ -321,7 +321,7 @@ class ShapeState {
       if (sc.root_token[r] == sc.token) continue;
       sc.root_token[r] = sc.token;
       if (next_member_[r] == r) continue;  // a lone vertex: at its place, no error
-      const ClusterPlacement pl = place_cluster(terms_[r], h_, params_.placement, [&](auto&& visit) {
+      const ClusterPlacement pl = place_cluster(pool_[slot_[r]], h_, params_.placement, [&](auto&& visit) {
         for_each_member(r, [&](Index w) { visit(mesh_.positions[w]); });
       });
       err_[r] = pl.error;
@@ -354,7 +354,8 @@ class ShapeState {
         root = joined;
       }
       root = uf_.find(root);
-      terms_[root] = s.terms;
+      for (Index r : s.roots) drop_terms(r);
+      set_terms(root, s.terms);
       err_[root] = s.placement.error;
       pos_[root] = s.placement.position;
     }
@@ -374,6 +375,30 @@ class ShapeState {
     ClusterTerms t;
     t.add_vertex(quadrics_->terms[v], mesh_.positions[v]);
     return t;
+  }
+
+  // The summed terms of root r's cluster added to `sum` (a lone vertex's built as it always was,
+  // so the sums are the same bits whichever way they are stored).
+  void add_terms_of(Index r, ClusterTerms& sum) const {
+    if (slot_[r] == kInvalidIndex) sum += vertex_alone(r);
+    else sum += pool_[slot_[r]];
+  }
+  void set_terms(Index r, const ClusterTerms& t) {
+    if (slot_[r] == kInvalidIndex) {
+      if (free_slots_.empty()) {
+        slot_[r] = Index(pool_.size());
+        pool_.push_back(t);
+        return;
+      }
+      slot_[r] = free_slots_.back();
+      free_slots_.pop_back();
+    }
+    pool_[slot_[r]] = t;
+  }
+  void drop_terms(Index r) {
+    if (slot_[r] == kInvalidIndex) return;
+    free_slots_.push_back(slot_[r]);
+    slot_[r] = kInvalidIndex;
   }
 
   // Eq. 1: a face with `kept` kept edges counts max(0, kept − 2) triangle-equivalents.
@@ -454,7 +479,12 @@ class ShapeState {
   const ShapeSelectionParams& params_;
   UnionFind uf_;
   double h_ = 1.0, norm_ = 1.0;
-  std::vector<ClusterTerms> terms_;  // per root
+  // The summed terms of every cluster of two or more members, at slot_[root]; a vertex alone
+  // has none stored (vertex_alone builds them from the vertex quadrics): 4 bytes a vertex
+  // instead of 232, most of the state on a large mesh (issue 20: the 1M grid's peak).
+  std::vector<Index> slot_;
+  std::vector<ClusterTerms> pool_;
+  std::vector<Index> free_slots_;
   // The vertex quadrics the terms come from (a vertex alone: vertex_alone), borrowed or own;
   // kept rather than a copy of every vertex's ClusterTerms (208 bytes a vertex, issue 20).
   VertexQuadrics own_quadrics_;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -30,6 +31,40 @@ std::size_t parallel_chunks(std::size_t n, int threads, std::size_t min_parallel
   work(0, std::min(n, chunk), std::size_t{0});
   for (std::thread& th : pool) th.join();
   return t;
+}
+
+}  // namespace quadlod
+
+namespace quadlod {
+
+/// Runs `beside` on a second thread while `work` runs on the calling thread, when `threads`
+/// allows more than one and `overlap` is true; otherwise `work`, then `beside`. For independent
+/// computations (each reads only what both share and writes only its own results), so what they
+/// compute does not depend on which way they ran. An exception thrown by `beside` is rethrown
+/// here after both finished.
+template <class Work, class Beside>
+void run_beside(int threads, bool overlap, Work&& work, Beside&& beside) {
+  if (!overlap || thread_count(threads) < 2) {
+    work();
+    beside();
+    return;
+  }
+  std::exception_ptr failed;
+  std::thread side([&] {
+    try {
+      beside();
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  });
+  try {
+    work();
+  } catch (...) {
+    side.join();
+    throw;
+  }
+  side.join();
+  if (failed) std::rethrow_exception(failed);
 }
 
 }  // namespace quadlod
