@@ -492,12 +492,14 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
     if (blamed_.empty() && !face_island_.empty()) {
       // A round can split an island none of whose faces it touched: collapsing a coincident
       // sheet onto an island's edge makes that edge non-manifold (cg57 at 0.6). So before the
-      // collapse is final, every island is checked once more.
+      // collapse is final, every island is checked once more — but for those check(dirty) just
+      // found whole: nothing changed since (on a UV grid, one island of the whole mesh: a
+      // second full check per pass, issue 20).
       if (all_faces.empty()) {
         all_faces.resize(nf_);
         std::iota(all_faces.begin(), all_faces.end(), Index{0});
       }
-      check_islands(all_faces);
+      check_islands(all_faces, /*skip_checked=*/true);
     }
     if (blamed_.empty()) break;
     // Refuse: split every blamed cluster (they are distinct clusters of this round).

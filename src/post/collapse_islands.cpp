@@ -42,14 +42,15 @@ void Collapser::protect_islands() {
   for (Index f = 0; f < nf_; ++f)
     if (face_island_[f] != kInvalidIndex) island_faces_[fill[face_island_[f]]++] = f;
   island_keep_.assign(n, 0);
-  island_pieces_.assign(n, 0);
+  // Every island is one edge-connected piece in the input: find_uv_islands joins faces across
+  // the connectivity's edges, and an edge is a vertex pair, so two faces it joins share a side.
+  // A split is therefore any island the collapse leaves in more than one piece.
   for (Index i = 0; i < n; ++i) {
     double area = islands.area_3d[i];
     if (params_.face_island_area && params_.face_island_area->size() == nf_)
       for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k)
         area = std::max(area, (*params_.face_island_area)[island_faces_[k]]);
     island_keep_[i] = area > 0.0 && area >= params_.min_kept_island_area;
-    island_pieces_[i] = island_components(i, [&](Index c) { return mesh_.corner_vertex[c]; }, nullptr);
   }
   island_token_.assign(n, 0);
   root_component_.assign(nv_, kInvalidIndex);
@@ -86,31 +87,21 @@ void Collapser::sort_sides() {
   sides_.swap(sides_sorted_);
 }
 
-// Edge-connected components of island i's faces with corners mapped by vertex_of (input
-// vertices, or output vertices = cluster roots over the surviving pieces). piece_component, when
-// given, gets each surviving piece's component, in the order of island_faces_ and pieces.
-template <class VertexOf>
-Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component) {
+// Edge-connected components of island i's surviving pieces, their corners at the output
+// vertices (cluster roots). piece_component gets each surviving piece's component, in the order
+// of island_faces_ and pieces.
+Index Collapser::island_components(Index i, std::vector<Index>& piece_component) {
   std::vector<IslandSide>& sides = sides_;
   sides.clear();
   fan_root_ = kInvalidIndex;  // fan_ may have been rebuilt since the last call
   Index pieces = 0;
-  const bool built = piece_component != nullptr;
   for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k) {
     const Index f = island_faces_[k];
-    if (!built) {  // the input face itself
-      for (Index c = mesh_.face_begin(f); c < mesh_.face_end(f); ++c) {
-        const Index a = vertex_of(c), b = vertex_of(mesh_.face_begin(f) + (c + 1 - mesh_.face_begin(f)) % mesh_.face_size(f));
-        sides.push_back({std::min(a, b), std::max(a, b), pieces});
-      }
-      ++pieces;
-      continue;
-    }
     Index off = piece_base(f);
     for (Index p = 0; p < piece_count_[f]; ++p) {
       const Index len = piece_buf_[off];
       for (Index j = 0; j < len; ++j) {
-        const Index a = vertex_of(piece_buf_[off + 1 + j]), b = vertex_of(piece_buf_[off + 1 + (j + 1) % len]);
+        const Index a = root_of_corner(piece_buf_[off + 1 + j]), b = root_of_corner(piece_buf_[off + 1 + (j + 1) % len]);
         sides.push_back({std::min(a, b), std::max(a, b), pieces});
       }
       ++pieces;
@@ -119,10 +110,7 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
   }
   sort_sides();
   UnionFind uf(pieces);
-  if (!built) {
-    for (std::size_t k = 1; k < sides.size(); ++k)
-      if (sides[k].a == sides[k - 1].a && sides[k].b == sides[k - 1].b) uf.unite(sides[k].piece, sides[k - 1].piece);
-  } else {
+  {
     // find_uv_islands joins faces only across edges with exactly two faces, so an output side
     // joins two pieces only if no other output face lies on it. A collapse can fold an island
     // onto itself or onto a coincident sheet (flightgear_cg57_cruiser_hd at 0.6: one side with
@@ -141,11 +129,11 @@ Index Collapser::island_components(Index i, VertexOf&& vertex_of, std::vector<In
   }
   Index components = 0;
   std::vector<Index> id(pieces, kInvalidIndex);
-  if (built) piece_component->assign(pieces, kInvalidIndex);
+  piece_component.assign(pieces, kInvalidIndex);
   for (Index p = 0; p < pieces; ++p) {
     Index& c = id[uf.find(p)];
     if (c == kInvalidIndex) c = components++;
-    if (built) (*piece_component)[p] = c;
+    piece_component[p] = c;
   }
   return components;
 }
@@ -172,11 +160,13 @@ Index Collapser::pieces_on_side(Index a, Index b) {
 //   * vanished: an island of at least min_kept_island_area without any surviving face. The
 //     clusters at the corners of its largest face are refused (split, then dissolved), until that
 //     face survives; refusing every cluster on the island would undo far more than needed.
-//   * split: its surviving pieces fall into more edge-connected components than its input faces
-//     had (one). The clusters at the corners of the dropped faces between two components are
+//   * split: its surviving pieces fall into more than one edge-connected component (every island
+//     is one in the input; protect_islands). The clusters at the corners of the dropped faces between two components are
 //     refused — the ring of a tube collapsed to a point on each side of a dropped band.
-void Collapser::check_islands(const std::vector<Index>& dirty) {
-  ++island_tok_;
+// With skip_checked, the islands the previous call checked are left out: the final check of a
+// round that refused nothing sees them as that call did.
+void Collapser::check_islands(const std::vector<Index>& dirty, bool skip_checked) {
+  if (!skip_checked) ++island_tok_;
   std::vector<Index> piece_component;
   for (Index f : dirty) {
     const Index i = face_island_[f];
@@ -191,8 +181,8 @@ void Collapser::check_islands(const std::vector<Index>& dirty) {
         blame(root_of_corner(c), CollapseRefusal::Island);
       continue;
     }
-    const Index components = island_components(i, [&](Index c) { return root_of_corner(c); }, &piece_component);
-    if (components <= island_pieces_[i]) continue;
+    const Index components = island_components(i, piece_component);
+    if (components <= 1) continue;
     // The component of every root on a surviving piece, then the dropped faces touching two.
     ++component_tok_;
     Index p = 0;

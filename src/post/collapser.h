@@ -118,7 +118,6 @@ class Collapser {
   std::vector<Index> face_island_;  // per input face: its island, or kInvalidIndex
   std::vector<Index> island_begin_, island_faces_;  // faces of island i: [begin[i], begin[i+1])
   std::vector<std::uint8_t> island_keep_;   // 1: must keep a face (area >= min_kept_island_area)
-  std::vector<Index> island_pieces_;        // edge-connected pieces of the island in the input
   std::vector<Index> island_token_;
   Index island_tok_ = 0;
   std::vector<Index> root_component_, root_component_token_;  // per root, during check_islands
@@ -136,9 +135,9 @@ class Collapser {
   Index component_tok_ = 0;
   void sort_sides();
   void protect_islands();
-  void check_islands(const std::vector<Index>& dirty);
-  template <class VertexOf>
-  Index island_components(Index i, VertexOf&& vertex_of, std::vector<Index>* piece_component);
+  // skip_checked: leave out the islands the last call checked (nothing changed since).
+  void check_islands(const std::vector<Index>& dirty, bool skip_checked = false);
+  Index island_components(Index i, std::vector<Index>& piece_component);
   Index pieces_on_side(Index a, Index b);
   FeatureEdges own_feat_;
   const FeatureEdges* feat_ptr_ = nullptr;

@@ -609,11 +609,17 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
       std::lock_guard lock(filled_mutex);
       filled.push_back({begin, out});
     };
-    parallel_chunks(n, params.threads, params.min_parallel_candidates, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
-      if (chunk == 0) return price(begin, end, nullptr);  // the state's own scratch
-      Scratch scratch = state.make_scratch();
-      price(begin, end, &scratch);
-    });
+    // Weighted by edges: a segment move costs about its edge count in single pricings.
+    std::vector<Scratch> scratch(std::max<std::size_t>(1, thread_count(params.threads)) - 1);
+    parallel_weighted_chunks(
+        n, params.threads, params.min_parallel_candidates, params.pricing_chunks_per_thread,
+        [&](std::size_t i) { return i < std::size_t(nu) ? double(units.of(Index(i)).size()) : 1.0; },
+        [&](std::size_t begin, std::size_t end, std::size_t worker) {
+          if (worker == 0) return price(begin, end, nullptr);  // the state's own scratch
+          Scratch& own = scratch[worker - 1];
+          if (own.root_token.empty()) own = state.make_scratch();
+          price(begin, end, &own);
+        });
     std::sort(filled.begin(), filled.end());
     std::size_t size = 0;
     for (const auto& [begin, end] : filled) {
