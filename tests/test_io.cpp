@@ -867,3 +867,49 @@ TEST(IoNumbers, FastDecimalPathAgreesWithFromCharsBitForBit) {
   EXPECT_EQ(v, 2.5);
   EXPECT_EQ(*next, ' ');
 }
+
+// A mesh large enough that its lines are formatted in chunks on several threads (io/obj.cpp):
+// the text reads back as the same mesh, and a name statement appears only where a face's tag
+// differs from the face before it — none repeated or lost where a chunk begins.
+TEST(IoWrite, ChunkedObjTextIsTheSameMeshWithOneStatementPerTagChange) {
+  PolyMesh m = quad_grid(400, 300);  // 120 000 faces, 120 701 vertices and UVs
+  ASSERT_GT(m.num_faces(), 100000);
+  // Whole numbers and binary fractions: they read back exactly at the default precision.
+  for (Vec3& p : m.positions) p = (p * 1200.0).array().round().matrix();
+  for (Vec2& t : m.uv_sets[0].values) t = (t * 64.0).array().round().matrix() / 64.0;
+  m.material_names = {"red", "blue", "green"};
+  m.group_names = {"a", "b"};
+  const Index nf = m.num_faces();
+  m.face_material.resize(nf);
+  m.face_group.resize(nf);
+  m.face_smoothing.resize(nf);
+  std::size_t material_changes = 0, group_changes = 0, smoothing_changes = 0;
+  for (Index f = 0; f < nf; ++f) {
+    // Runs of unequal lengths (untagged leading faces included), so chunk starts fall anywhere.
+    m.face_material[f] = f < 5 ? X : Index((f / 37) % 3);
+    m.face_group[f] = Index((f / 1009) % 2);
+    m.face_smoothing[f] = (f / 53) % 2;
+    if (m.face_material[f] != (f == 0 ? X : m.face_material[f - 1])) ++material_changes;
+    if (m.face_group[f] != (f == 0 ? X : m.face_group[f - 1])) ++group_changes;
+    if (f == 0 || m.face_smoothing[f] != m.face_smoothing[f - 1]) ++smoothing_changes;
+  }
+  const std::string text = io_test::obj_bytes(m, "chunked");
+  auto count_lines = [&](const std::string& prefix) {
+    std::size_t n = 0;
+    for (std::size_t at = 0; at < text.size();) {
+      const std::size_t end = text.find('\n', at);
+      if (text.compare(at, prefix.size(), prefix) == 0) ++n;
+      at = end == std::string::npos ? text.size() : end + 1;
+    }
+    return n;
+  };
+  EXPECT_EQ(count_lines("usemtl "), material_changes);
+  EXPECT_EQ(count_lines("g "), group_changes);
+  EXPECT_EQ(count_lines("s "), smoothing_changes);
+  EXPECT_EQ(count_lines("v "), std::size_t(m.num_vertices()));
+  EXPECT_EQ(count_lines("vt "), m.uv_sets[0].values.size());
+  EXPECT_EQ(count_lines("f "), std::size_t(nf));
+  const ReadResult back = obj(text);
+  ASSERT_TRUE(back.ok()) << back.error;
+  EXPECT_EQ(mesh_difference(m, back.mesh), "");
+}

@@ -75,8 +75,9 @@ struct SimplifyOptions {
   /// same for any count), CBC and the annealing runs of the paper objective; 0 = all cores.
   int threads = 0;
   /// From this many faces on, a pass builds its vertex quadrics and feature lines on a second
-  /// thread beside the analysis (speed only: the output is the same either way). Below it the
-  /// three take a few milliseconds together and a thread's start is not worth it; not tuned.
+  /// thread beside the analysis, and the run its input surface's BVH beside the feature lines
+  /// and UV islands (speed only: the output is the same either way). Below it they take a few
+  /// milliseconds together and a thread's start is not worth it; not tuned.
   Index min_faces_beside = 20000;
   std::uint32_t seed = 1;
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)

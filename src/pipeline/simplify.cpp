@@ -615,21 +615,25 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   bool time_bound_reached = false;
   // Every pass checks orientation against the original input surface (docs/metrics.md §6b) ...
   std::optional<SurfaceReference> surface;
-  if (cp.check_surface_orientation) {
-    surface = make_surface_reference(input, options.threads);
-    cp.surface_reference = &*surface;
-  }
   // ... and measures feature_tolerance against the original input's strict lines.
   std::optional<FeatureReference> reference;
-  if (options.features) {
-    const Connectivity conn = build_connectivity(input);
-    reference = make_feature_reference(input, conn, find_feature_edges(input, conn, cp.features));
-    cp.feature_reference = &*reference;
-  }
+  std::optional<UvIslands> input_islands;
+  // The surface's BVH on one thread, the feature lines and UV islands beside it (independent).
+  run_beside(
+      options.threads, input.num_faces() >= options.min_faces_beside,
+      [&] {
+        if (cp.check_surface_orientation) surface = make_surface_reference(input, options.threads);
+      },
+      [&] {
+        if (!options.features) return;
+        const Connectivity conn = build_connectivity(input);
+        reference = make_feature_reference(input, conn, find_feature_edges(input, conn, cp.features));
+        if (!input.uv_sets.empty()) input_islands = find_uv_islands(input, conn, 0);
+      });
+  if (surface) cp.surface_reference = &*surface;
+  if (reference) cp.feature_reference = &*reference;
   PolyMesh current;
   const PolyMesh* pass_input = &input;
-  std::optional<UvIslands> input_islands;
-  if (options.features && !input.uv_sets.empty()) input_islands = find_uv_islands(input, build_connectivity(input), 0);
   // Output face → original input face, composed over the passes (exact island accounting).
   std::vector<Index> face_origin(input.num_faces());
   std::iota(face_origin.begin(), face_origin.end(), Index{0});

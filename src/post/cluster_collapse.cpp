@@ -26,6 +26,7 @@
 #include "geometry/sampling.h"
 #include "mesh/union_find.h"
 #include "post/collapser.h"
+#include "util/parallel.h"
 #include "util/progress.h"
 
 #include <Eigen/Cholesky>
@@ -50,17 +51,21 @@ void Collapser::precompute() {
   diag_ = bounding_box(mesh_).diagonal();
   if (!(diag_ > 0.0) || !std::isfinite(diag_)) diag_ = 1.0;
 
+  // Per edge and per face on all threads (each item written by one chunk); the sum in edge order.
   edge_len_.resize(ne_);
+  parallel_chunks(std::size_t(ne_), params_.threads, params_.min_parallel_faces, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t i = b; i < e; ++i) {
+      const auto [v, w] = conn_.edge_vertices[i];
+      edge_len_[i] = (mesh_.positions[v] - mesh_.positions[w]).norm();
+    }
+  });
   double sum = 0.0;
   Index counted = 0;
-  for (Index e = 0; e < ne_; ++e) {
-    const auto [a, b] = conn_.edge_vertices[e];
-    edge_len_[e] = (mesh_.positions[a] - mesh_.positions[b]).norm();
+  for (Index e = 0; e < ne_; ++e)
     if (edge_len_[e] > 0.0) {
       sum += edge_len_[e];
       ++counted;
     }
-  }
   h_ = counted > 0 ? sum / counted : diag_;
 
   zero_area_ = std::max(0.0, params_.zero_area_epsilon) * diag_ * diag_;
@@ -72,11 +77,13 @@ void Collapser::precompute() {
 
   face_n_.resize(nf_);
   face_area_.resize(nf_);
-  for (Index f = 0; f < nf_; ++f) {
-    const Vec3 av = face_area_vector(mesh_, f);
-    face_area_[f] = av.norm();
-    face_n_[f] = face_area_[f] > 0.0 ? Vec3(av / face_area_[f]) : Vec3::Zero();
-  }
+  parallel_chunks(std::size_t(nf_), params_.threads, params_.min_parallel_faces, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (Index f = Index(b); f < Index(e); ++f) {
+      const Vec3 av = face_area_vector(mesh_, f);
+      face_area_[f] = av.norm();
+      face_n_[f] = face_area_[f] > 0.0 ? Vec3(av / face_area_[f]) : Vec3::Zero();
+    }
+  });
   input_nm_.assign(nv_, -1);
   if (params_.check_surface_orientation) {
     surface_ = params_.surface_reference;

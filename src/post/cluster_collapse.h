@@ -81,9 +81,10 @@ struct ClusterCollapseParams {
   const VertexQuadrics* vertex_quadrics = nullptr;
   /// Threads of the face checks of a round (each dirty face checked alone; the refusals are
   /// replayed in face order, so the output does not depend on the count) and of the attribute
-  /// projection (clusters in chunks, their new values appended in chunk order); 0 = all cores. A
-  /// round with fewer than min_parallel_faces dirty faces (a mesh with fewer vertices, for the
-  /// projection) runs on one thread.
+  /// projection (clusters in chunks, their new values appended in chunk order) and of the
+  /// per-face and per-edge set-up; 0 = all cores. A round with fewer than min_parallel_faces
+  /// dirty faces (a mesh with fewer vertices, for the projection; fewer faces or edges, for the
+  /// set-up) runs on one thread.
   int threads = 0;
   std::size_t min_parallel_faces = 20000;
 
