@@ -1,0 +1,53 @@
+// quadlod — the final fit of the output's vertices to the input surface (issue 24; docs/cluster_collapse.md,
+// "Surface fit").
+//
+// The collapse places every cluster by its quadric (volume-constrained where it can, Lindstrom &
+// Turk 1998), which keeps the volume but leaves vertices off the input surface: on the ram at 0.2
+// quadlod's vertices lay 2.9e-3 of the diagonal from the input on average against Single's 1.9e-3,
+// and a posed LOD carries that offset into every frame. The fit moves each output vertex a few
+// damped Gauss–Newton steps on the two-sided Chamfer energy between the output and the input:
+//
+//   E = Σ_{s on output} w_s d(s, M_in)² + Σ_{a on input} w_a d(a, M_out)²,
+//
+// fixed samples (barycentric points of every fan triangle, weights = area share) whose residuals
+// are spread onto the triangle's corners by their barycentric coordinates; each vertex moves by
+// the weighted mean of its residuals (a lumped, always-contracting step). Connectivity, UVs and
+// every other attribute stay as they are; a move that would turn an incident face by more than
+// `max_turn_deg`, shrink it below `min_area_ratio` of its area, or go farther than
+// `max_step_edge_fraction` of the vertex's shortest edge is not made (the vertex stays).
+#pragma once
+
+#include "quadlod/mesh.h"
+
+namespace quadlod {
+
+struct SurfaceFitParams {
+  /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
+  int iterations = 4;
+  /// Fraction of the computed move that is made (damping; 1 = the full lumped step).
+  double step = 1.0;
+  /// A vertex moves at most this fraction of its shortest incident edge per step, so no face can
+  /// degenerate in one step.
+  double max_step_edge_fraction = 0.25;
+  /// A sample whose closest point is farther than this multiple of its triangle's longest edge
+  /// belongs to another part (an eye in its socket, a leg against the body) and is not used.
+  double max_residual_edge_multiple = 1.0;
+  /// An incident face may turn by at most this angle (degrees) against its normal before the fit.
+  double max_turn_deg = 30.0;
+  /// An incident face may keep no less than this fraction of its area before the fit.
+  double min_area_ratio = 0.5;
+  int threads = 0;
+};
+
+struct SurfaceFitResult {
+  double energy_before = 0.0;  ///< E at the start (input units², area-weighted means summed)
+  double energy_after = 0.0;   ///< E at the end, with the same samples
+  Index moved_vertices = 0;    ///< vertices whose position changed
+  Index refused_moves = 0;     ///< vertex moves undone by the turn / area / step guards (summed over steps)
+};
+
+/// Fits output.positions to the surface of `input` (both pass check_layout(); faces of any
+/// degree, fan-triangulated). Deterministic for any thread count.
+SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const SurfaceFitParams& params = {});
+
+}  // namespace quadlod
