@@ -148,11 +148,15 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     return e;
   };
 
+  // A face may turn by max_turn_deg per step and shrink to min_area_ratio of its area before the
+  // step, and never face away from where it faced before the fit (no flip).
+  std::vector<Vec3> area_step(out_tris.size());
   auto face_ok = [&](Index i) {
     const Vec3 a = area_vector(output.positions, out_tris[i]);
-    const double n0 = area0[i].norm(), n1 = a.norm();
+    const double n0 = area_step[i].norm(), n1 = a.norm();
     if (n1 < params.min_area_ratio * n0) return false;
-    return n0 == 0.0 || a.dot(area0[i]) >= cos_turn * n0 * n1;
+    if (area0[i].squaredNorm() > 0.0 && !(a.dot(area0[i]) > 0.0)) return false;
+    return n0 == 0.0 || a.dot(area_step[i]) >= cos_turn * n0 * n1;
   };
 
   std::vector<Vec3> num(nv);
@@ -163,6 +167,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     const double e = energy(&num, &den);
     if (it == 0) result.energy_before = e;
     const std::vector<Vec3> before = output.positions;
+    for (std::size_t i = 0; i < out_tris.size(); ++i) area_step[i] = area_vector(before, out_tris[i]);
     std::vector<std::uint8_t> moved(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
       if (!(den[v] > 0.0) || vertex_tris[v].empty()) continue;

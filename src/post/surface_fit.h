@@ -12,9 +12,10 @@
 // fixed samples (barycentric points of every fan triangle, weights = area share) whose residuals
 // are spread onto the triangle's corners by their barycentric coordinates; each vertex moves by
 // the weighted mean of its residuals (a lumped, always-contracting step). Connectivity, UVs and
-// every other attribute stay as they are; a move that would turn an incident face by more than
-// `max_turn_deg`, shrink it below `min_area_ratio` of its area, or go farther than
-// `max_step_edge_fraction` of the vertex's shortest edge is not made (the vertex stays).
+// every other attribute stay as they are; a step that would turn an incident face by more than
+// `max_turn_deg`, shrink it below `min_area_ratio` of its area, or turn it away from the way it
+// faced before the fit (a flip) is undone for the face's vertices, and no vertex moves farther
+// than `max_step_edge_fraction` of its shortest edge in one step.
 #pragma once
 
 #include "quadlod/mesh.h"
@@ -32,9 +33,10 @@ struct SurfaceFitParams {
   /// A sample whose closest point is farther than this multiple of its triangle's longest edge
   /// belongs to another part (an eye in its socket, a leg against the body) and is not used.
   double max_residual_edge_multiple = 1.0;
-  /// An incident face may turn by at most this angle (degrees) against its normal before the fit.
+  /// An incident face may turn by at most this angle (degrees) in one step; against its normal
+  /// before the fit it may turn by anything short of a flip (90°).
   double max_turn_deg = 30.0;
-  /// An incident face may keep no less than this fraction of its area before the fit.
+  /// An incident face keeps at least this fraction of its area before the step.
   double min_area_ratio = 0.5;
   int threads = 0;
 };
