@@ -2,6 +2,7 @@
 #include "post/surface_fit.h"
 
 #include "geometry/bvh.h"
+#include "post/cluster_collapse.h"
 #include "util/parallel.h"
 
 #include <algorithm>
@@ -68,7 +69,11 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
   SurfaceFitResult result;
   const std::vector<FanTriangle> in_tris = fan_triangles(input), out_tris = fan_triangles(output);
   if (in_tris.empty() || out_tris.empty()) return result;
-  const TriangleBvh in_bvh(corners_of(input.positions, in_tris), {.threads = params.threads});
+  // The input surface as eval triangulates it, with unit normals: the reference of the closest
+  // points and of the orientation guard (the collapse's, cluster_collapse.h).
+  const SurfaceReference ref = make_surface_reference(input, params.threads);
+  const TriangleBvh& in_bvh = ref.bvh;
+  const double orientation_tol = params.orientation_tolerance * ref.longest_side;
   const std::size_t nv = output.positions.size();
 
   // Input samples: the centroid of every input triangle, or four points each where the input has
@@ -159,6 +164,40 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     return n0 == 0.0 || a.dot(area_step[i]) >= cos_turn * n0 * n1;
   };
 
+  // docs/metrics.md §6b, as the collapse applies it (collapse_checks.cpp): from a face's
+  // centroid, the nearest input triangle facing its way is at most twice as far as the nearest
+  // of either way, plus the tolerance.
+  auto faces_input = [&](Index f, double tol) {
+    const auto fv = output.face_vertices(f);
+    Vec3 c = Vec3::Zero(), av = Vec3::Zero();
+    for (std::size_t i = 0; i < fv.size(); ++i) {
+      const Vec3& a = output.positions[fv[i]];
+      c += a;
+      av += a.cross(output.positions[fv[i + 1 == fv.size() ? 0 : i + 1]]);
+    }
+    c /= static_cast<double>(fv.size());
+    const NearestHit any = in_bvh.nearest(c);
+    if (any.primitive == kInvalidIndex) return true;
+    const double reach = 2.0 * std::sqrt(any.distance_sq) + tol;
+    const double min_dot = 1e-3 * av.norm();  // as the collapse: near-perpendicular does not agree
+    const NearestHit agreeing = in_bvh.nearest_if(
+        c, [&](Index t) { return ref.normal[t].dot(av) >= min_dot; }, kInvalidIndex, reach * reach);
+    return agreeing.primitive != kInvalidIndex && std::sqrt(agreeing.distance_sq) <= reach;
+  };
+  // Per face, the slack it is held to: the collapse's where it passes with it, eval's (twice
+  // that) where only eval's holds, none where even eval's fails before the fit (already counted).
+  std::vector<double> face_tol(output.num_faces(), -1.0);
+  for (Index f = 0; f < output.num_faces(); ++f) {
+    if (faces_input(f, orientation_tol)) face_tol[f] = orientation_tol;
+    else if (faces_input(f, 2.0 * orientation_tol)) face_tol[f] = 2.0 * orientation_tol;
+  }
+  // A face that fails even eval's rule before the fit is an input face kept as it was (eval counts
+  // it apart, in flipped_faces_kept, only while its corners stay where they are): its vertices stay.
+  std::vector<std::uint8_t> fixed(nv, 0);
+  for (Index f = 0; f < output.num_faces(); ++f)
+    if (face_tol[f] < 0.0)
+      for (Index v : output.face_vertices(f)) fixed[v] = 1;
+
   std::vector<Vec3> num(nv);
   std::vector<double> den(nv);
   for (int it = 0; it < params.iterations; ++it) {
@@ -170,7 +209,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     for (std::size_t i = 0; i < out_tris.size(); ++i) area_step[i] = area_vector(before, out_tris[i]);
     std::vector<std::uint8_t> moved(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
-      if (!(den[v] > 0.0) || vertex_tris[v].empty()) continue;
+      if (fixed[v] || !(den[v] > 0.0) || vertex_tris[v].empty()) continue;
       Vec3 d = params.step * num[v] / den[v];
       double shortest = std::numeric_limits<double>::infinity();
       for (Index i : vertex_tris[v])
@@ -189,6 +228,20 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
       for (std::size_t i = 0; i < out_tris.size(); ++i) {
         if (face_ok(static_cast<Index>(i))) continue;
         for (Index v : out_tris[i].v)
+          if (moved[v]) {
+            output.positions[v] = before[v];
+            moved[v] = 0;
+            ++result.refused_moves;
+            changed = true;
+          }
+      }
+      if (changed) continue;  // the cheap checks first; the orientation once they hold
+      for (Index f = 0; f < output.num_faces(); ++f) {
+        const auto fv = output.face_vertices(f);
+        if (face_tol[f] < 0.0 || std::none_of(fv.begin(), fv.end(), [&](Index v) { return moved[v] != 0; }) ||
+            faces_input(f, face_tol[f]))
+          continue;
+        for (Index v : fv)
           if (moved[v]) {
             output.positions[v] = before[v];
             moved[v] = 0;

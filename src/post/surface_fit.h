@@ -14,7 +14,8 @@
 // the weighted mean of its residuals (a lumped, always-contracting step). Connectivity, UVs and
 // every other attribute stay as they are; a step that would turn an incident face by more than
 // `max_turn_deg`, shrink it below `min_area_ratio` of its area, or turn it away from the way it
-// faced before the fit (a flip) is undone for the face's vertices, and no vertex moves farther
+// faced before the fit (a flip), or leave it facing away from the input surface by eval's rule
+// (docs/metrics.md §6b), is undone for the face's vertices, and no vertex moves farther
 // than `max_step_edge_fraction` of its shortest edge in one step.
 #pragma once
 
@@ -38,6 +39,10 @@ struct SurfaceFitParams {
   double max_turn_deg = 30.0;
   /// An incident face keeps at least this fraction of its area before the step.
   double min_area_ratio = 0.5;
+  /// The orientation guard (docs/metrics.md §6b, as the collapse applies it): a face that faced
+  /// the input before the fit must still face it, with this slack (× the input's longest bbox
+  /// side; ClusterCollapseParams::orientation_tolerance, half of eval's).
+  double orientation_tolerance = 5e-4;
   int threads = 0;
 };
 
