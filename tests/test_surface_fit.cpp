@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -79,6 +80,25 @@ TEST(SurfaceFit, RaisedVertexComesDownUnlessTheTurnGuardRefuses) {
   const SurfaceFitResult refused = fit_to_surface(input, output, params);
   EXPECT_GT(refused.refused_moves, 0u);
   EXPECT_DOUBLE_EQ(output.positions[12].z(), 0.2);
+}
+
+TEST(SurfaceFit, FaceThatAlreadyFacesAwayKeepsItsVertices) {
+  // A reversed face lying on the input faces away from it (eval counts such a face apart only
+  // while it is exactly as it was): its four corners stay; the other five vertices come down.
+  const PolyMesh input = make_grid(8, 8);
+  PolyMesh output = make_grid(2, 2);
+  for (Vec3& p : output.positions) p.z() += 1e-4;  // within the orientation slack of the plane
+  const Index b = output.face_begin(0);
+  std::reverse(output.corner_vertex.begin() + b, output.corner_vertex.begin() + output.face_end(0));
+  const std::vector<Index> reversed(output.corner_vertex.begin() + b, output.corner_vertex.begin() + output.face_end(0));
+  SurfaceFitParams params;
+  params.iterations = 1;
+  const SurfaceFitResult r = fit_to_surface(input, output, params);
+  EXPECT_EQ(r.moved_vertices, 5u);
+  for (Index v = 0; v < output.positions.size(); ++v) {
+    const bool kept = std::find(reversed.begin(), reversed.end(), v) != reversed.end();
+    EXPECT_NEAR(output.positions[v].z(), kept ? 1e-4 : 0.0, 1e-12) << "vertex " << v;
+  }
 }
 
 TEST(SurfaceFit, StepNeverExceedsTheEdgeFraction) {
