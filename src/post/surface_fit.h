@@ -10,7 +10,8 @@
 //
 //   E = Σ_{s on output} w_s d(s, M_in)² + Σ_{a on input} w_a d(a, M_out)²,
 //
-// fixed samples (barycentric points of every fan triangle, weights = area share) whose residuals
+// fixed samples (4 barycentric points of every output fan triangle, 1 or 4 of every input one,
+// weights = area share) whose residuals
 // are spread onto the triangle's corners by their barycentric coordinates; each vertex moves by
 // the weighted mean of its residuals (a lumped step, which does not overshoot when neighbours move together). Connectivity, UVs and
 // every other attribute stay as they are; a step that would turn an incident face by more than
