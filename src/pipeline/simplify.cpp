@@ -698,6 +698,19 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     SurfaceFitParams fp;
     fp.iterations = options.surface_fit_iterations;
     fp.threads = options.threads;
+    // Vertices on the lines eval holds to the input's (boundaries, non-manifold edges, UV seams,
+    // material borders: seams_torn) stay where the collapse put them.
+    std::vector<std::uint8_t> on_line;
+    if (options.features) {
+      const Connectivity out_conn = build_connectivity(current);
+      const FeatureEdges out_feat = find_feature_edges(current, out_conn, cp.features);
+      constexpr std::uint8_t kLines = kFeatureBoundary | kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
+      on_line.assign(current.positions.size(), 0);
+      for (Index e = 0; e < out_conn.num_edges; ++e)
+        if (out_feat.edge_bits[e] & kLines)
+          for (Index v : out_conn.edge_vertices[e]) on_line[v] = 1;
+      fp.fixed_vertices = &on_line;
+    }
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
                              {"energy_before", fit.energy_before},

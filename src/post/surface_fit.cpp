@@ -198,6 +198,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
   // A face that fails even eval's rule before the fit is an input face kept as it was (eval counts
   // it apart, in flipped_faces_kept, only while its corners stay where they are): its vertices stay.
   std::vector<std::uint8_t> fixed(nv, 0);
+  if (params.fixed_vertices && params.fixed_vertices->size() == nv) fixed = *params.fixed_vertices;
   for (Index f = 0; f < output.num_faces(); ++f)
     if (face_tol[f] < 0.0)
       for (Index v : output.face_vertices(f)) fixed[v] = 1;
