@@ -698,13 +698,15 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     SurfaceFitParams fp;
     fp.iterations = options.surface_fit_iterations;
     fp.threads = options.threads;
-    // Vertices on the lines eval holds to the input's (boundaries, non-manifold edges, UV seams,
-    // material borders: seams_torn) stay where the collapse put them.
+    // Vertices on non-manifold edges, UV seams and material borders stay where the collapse put
+    // them (eval holds seams to the input's: seams_torn). Boundary vertices move: the ram's eye
+    // and socket rims are boundaries, and fixing them gave back half the fit's gain on Fig. 10
+    // (docs/benchmarks/fig10-2026-12-03.md).
     std::vector<std::uint8_t> on_line;
     if (options.features) {
       const Connectivity out_conn = build_connectivity(current);
       const FeatureEdges out_feat = find_feature_edges(current, out_conn, cp.features);
-      constexpr std::uint8_t kLines = kFeatureBoundary | kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
+      constexpr std::uint8_t kLines = kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
       on_line.assign(current.positions.size(), 0);
       for (Index e = 0; e < out_conn.num_edges; ++e)
         if (out_feat.edge_bits[e] & kLines)

@@ -48,9 +48,9 @@ struct SurfaceFitParams {
   /// the input before the fit must still face it, with this slack (× the input's longest bbox
   /// side; ClusterCollapseParams::orientation_tolerance, half of eval's).
   double orientation_tolerance = 5e-4;
-  /// Per output vertex, 1 = it does not move (the pipeline passes the vertices on boundaries,
-  /// non-manifold edges, UV seams and material borders, whose lines eval holds to the input's:
-  /// `seams_torn`, docs/metrics.md §6c). nullptr or empty: every vertex may move.
+  /// Per output vertex, 1 = it does not move (the pipeline passes the vertices on non-manifold
+  /// edges, UV seams and material borders, whose lines eval holds to the input's: `seams_torn`,
+  /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
   const std::vector<std::uint8_t>* fixed_vertices = nullptr;
   int threads = 0;
 };
