@@ -136,6 +136,11 @@ struct SimplifyOptions {
   /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7
   /// did; false = by their quadric (ClusterCollapseParams::place_on_hard_edges, measured).
   bool place_on_hard_edges = false;
+  /// Gauss–Newton steps of the final fit of the output's vertices to the input surface
+  /// (fit_to_surface, src/post/surface_fit.h; docs/cluster_collapse.md, "Surface fit"): each
+  /// vertex moves on the two-sided Chamfer energy, connectivity and attributes unchanged, no face
+  /// turned or shrunk. 0 = the collapse's placements as they are.
+  int surface_fit_iterations = 4;
 
   // --- skinning (issue 24; docs/skinning.md) ----------------------------------------------------
   /// With a skinned input (PolyMesh::skin): the output gets weights by projection onto the input

@@ -8,6 +8,7 @@
 #include "post/cluster_collapse.h"
 #include "pipeline/storage_precision.h"
 #include "post/dual_repair.h"
+#include "post/surface_fit.h"
 #include "select/selection.h"
 #include "select/shape_selection.h"
 #include "skin/skin_borders.h"
@@ -709,6 +710,36 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"dual", seconds_dual},
                              {"collapse", seconds_collapse}};
 
+  // The final fit to the input surface (surface_fit.h): after the last pass, so it moves the
+  // vertices the output keeps; the weights follow the moved vertices.
+  if (options.surface_fit_iterations > 0 && result.target < result.input_tri_equivalent &&
+      pass_input == &current) {
+    SurfaceFitParams fp;
+    fp.iterations = options.surface_fit_iterations;
+    fp.threads = options.threads;
+    // Vertices on non-manifold edges, UV seams and material borders stay where the collapse put
+    // them (eval holds seams to the input's: seams_torn). Boundary vertices move: the ram's eye
+    // and socket rims are boundaries, and fixing them gave back half the fit's gain on Fig. 10
+    // (docs/benchmarks/fig10-2026-12-03.md).
+    std::vector<std::uint8_t> on_line;
+    if (options.features) {
+      const Connectivity out_conn = build_connectivity(current);
+      const FeatureEdges out_feat = find_feature_edges(current, out_conn, cp.features);
+      constexpr std::uint8_t kLines = kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
+      on_line.assign(current.positions.size(), 0);
+      for (Index e = 0; e < out_conn.num_edges; ++e)
+        if (out_feat.edge_bits[e] & kLines)
+          for (Index v : out_conn.edge_vertices[e]) on_line[v] = 1;
+      fp.fixed_vertices = &on_line;
+    }
+    const SurfaceFitResult fit = fit_to_surface(input, current, fp);
+    report["surface_fit"] = {{"iterations", fp.iterations},
+                             {"energy_before", fit.energy_before},
+                             {"energy_after", fit.energy_after},
+                             {"moved_vertices", fit.moved_vertices},
+                             {"refused_moves", fit.refused_moves}};
+    if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
+  }
   // Summary.
   result.mesh = std::move(current);
   result.note = last.note;
@@ -813,6 +844,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"features", options.features},
       {"hard_angle_deg", options.hard_angle_deg},
       {"place_on_hard_edges", options.place_on_hard_edges},
+      {"surface_fit_iterations", options.surface_fit_iterations},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},

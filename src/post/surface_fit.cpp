@@ -1,0 +1,264 @@
+// The final fit of the output's vertices to the input surface: see surface_fit.h.
+#include "post/surface_fit.h"
+
+#include "geometry/bvh.h"
+#include "post/cluster_collapse.h"
+#include "util/parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace quadlod {
+namespace {
+
+struct FanTriangle {
+  std::array<Index, 3> v;
+};
+
+std::vector<FanTriangle> fan_triangles(const PolyMesh& m) {
+  std::vector<FanTriangle> t;
+  t.reserve(m.corner_vertex.size());
+  for (Index f = 0; f < m.num_faces(); ++f) {
+    const auto fv = m.face_vertices(f);
+    for (std::size_t k = 1; k + 1 < fv.size(); ++k) t.push_back({{fv[0], fv[k], fv[k + 1]}});
+  }
+  return t;
+}
+
+Vec3 area_vector(const std::vector<Vec3>& p, const FanTriangle& t) {
+  return 0.5 * (p[t.v[1]] - p[t.v[0]]).cross(p[t.v[2]] - p[t.v[0]]);
+}
+
+double longest_edge(const std::vector<Vec3>& p, const FanTriangle& t) {
+  return std::max({(p[t.v[1]] - p[t.v[0]]).norm(), (p[t.v[2]] - p[t.v[1]]).norm(), (p[t.v[0]] - p[t.v[2]]).norm()});
+}
+
+std::vector<std::array<Vec3, 3>> corners_of(const std::vector<Vec3>& p, const std::vector<FanTriangle>& tris) {
+  std::vector<std::array<Vec3, 3>> c(tris.size());
+  for (std::size_t i = 0; i < tris.size(); ++i) c[i] = {p[tris[i].v[0]], p[tris[i].v[1]], p[tris[i].v[2]]};
+  return c;
+}
+
+// Barycentric points of a triangle: its centroid and the centroids of the three corner
+// sub-triangles of its midpoint subdivision (a fixed, symmetric set: the output's samples; the
+// input's are the first one or all four, see below). Four, not more: the queries are the fit's
+// whole cost (7 points per output triangle and 4 per input one took 19 s of a 25 s reduction of
+// assimp_suzanne_subdiv at 0.4 on one thread).
+constexpr std::array<std::array<double, 3>, 4> kPoints = {{{1.0 / 3, 1.0 / 3, 1.0 / 3},
+                                                           {2.0 / 3, 1.0 / 6, 1.0 / 6},
+                                                           {1.0 / 6, 2.0 / 3, 1.0 / 6},
+                                                           {1.0 / 6, 1.0 / 6, 2.0 / 3}}};
+
+// Barycentric coordinates of x (a point of triangle abc) — for spreading a residual on the corners.
+std::array<double, 3> barycentric(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e0 = b - a, e1 = c - a, d = x - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = d.dot(e0), d21 = d.dot(e1);
+  const double den = d00 * d11 - d01 * d01;
+  if (!(den > 0.0)) return {1.0 / 3, 1.0 / 3, 1.0 / 3};
+  const double v = std::clamp((d11 * d20 - d01 * d21) / den, 0.0, 1.0);
+  const double w = std::clamp((d00 * d21 - d01 * d20) / den, 0.0, 1.0 - v);
+  return {1.0 - v - w, v, w};
+}
+
+}  // namespace
+
+SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const SurfaceFitParams& params) {
+  SurfaceFitResult result;
+  const std::vector<FanTriangle> in_tris = fan_triangles(input), out_tris = fan_triangles(output);
+  if (in_tris.empty() || out_tris.empty()) return result;
+  // The input surface as eval triangulates it, with unit normals: the reference of the closest
+  // points and of the orientation guard (the collapse's, cluster_collapse.h).
+  const SurfaceReference ref = make_surface_reference(input, params.threads);
+  const TriangleBvh& in_bvh = ref.bvh;
+  const double orientation_tol = params.orientation_tolerance * ref.longest_side;
+  const std::size_t nv = output.positions.size();
+
+  // Input samples: the centroid of every input triangle, or four points each where the input has
+  // fewer triangles than the output (so every output triangle sees some).
+  const int in_points = in_tris.size() >= out_tris.size() ? 1 : 4;
+  std::vector<Vec3> in_samples;
+  std::vector<double> in_weight;
+  double in_area = 0.0;
+  for (const FanTriangle& t : in_tris) {
+    const double a = area_vector(input.positions, t).norm();
+    in_area += a;
+    for (int k = 0; k < in_points; ++k) {
+      const auto& b = kPoints[k];
+      in_samples.push_back(b[0] * input.positions[t.v[0]] + b[1] * input.positions[t.v[1]] + b[2] * input.positions[t.v[2]]);
+      in_weight.push_back(a / in_points);
+    }
+  }
+  if (!(in_area > 0.0)) return result;
+  for (double& w : in_weight) w /= in_area;
+
+  // Vertex → incident fan triangles (for the guards and the step bound).
+  std::vector<std::vector<Index>> vertex_tris(nv);
+  for (std::size_t i = 0; i < out_tris.size(); ++i)
+    for (Index v : out_tris[i].v) vertex_tris[v].push_back(static_cast<Index>(i));
+  std::vector<Vec3> area0(out_tris.size());
+  for (std::size_t i = 0; i < out_tris.size(); ++i) area0[i] = area_vector(output.positions, out_tris[i]);
+  const double cos_turn = std::cos(params.max_turn_deg * M_PI / 180.0);
+  const std::vector<Vec3> start = output.positions;
+
+  // The previous step's closest triangle of every sample seeds its next query (the answer does
+  // not depend on it; the search prunes more). Triangle ids of both sets are fixed.
+  std::vector<Index> out_hint(out_tris.size() * kPoints.size(), kInvalidIndex), in_hint(in_samples.size(), kInvalidIndex);
+  // One evaluation of E at the current positions; with `num`/`den`, the lumped step's sums.
+  auto energy = [&](std::vector<Vec3>* num, std::vector<double>* den) {
+    const std::vector<Vec3>& p = output.positions;
+    double out_area = 0.0;
+    for (const FanTriangle& t : out_tris) out_area += area_vector(p, t).norm();
+    if (!(out_area > 0.0)) return 0.0;
+    // Output samples → input surface (queries in parallel, sums in sample order: deterministic).
+    const std::size_t n_out = out_tris.size() * kPoints.size();
+    std::vector<Vec3> closest(n_out);
+    parallel_chunks(n_out, params.threads, 4096, [&](std::size_t begin, std::size_t end, std::size_t) {
+      for (std::size_t s = begin; s < end; ++s) {
+        const FanTriangle& t = out_tris[s / kPoints.size()];
+        const auto& b = kPoints[s % kPoints.size()];
+        const NearestHit h = in_bvh.nearest(b[0] * p[t.v[0]] + b[1] * p[t.v[1]] + b[2] * p[t.v[2]], out_hint[s]);
+        closest[s] = h.point;
+        out_hint[s] = h.primitive;
+      }
+    });
+    // Input samples → output surface.
+    const TriangleBvh out_bvh(corners_of(p, out_tris), {.threads = params.threads});
+    std::vector<NearestHit> hit(in_samples.size());
+    parallel_chunks(in_samples.size(), params.threads, 4096, [&](std::size_t begin, std::size_t end, std::size_t) {
+      for (std::size_t s = begin; s < end; ++s) in_hint[s] = (hit[s] = out_bvh.nearest(in_samples[s], in_hint[s])).primitive;
+    });
+    double e = 0.0;
+    for (std::size_t s = 0; s < n_out; ++s) {
+      const FanTriangle& t = out_tris[s / kPoints.size()];
+      const auto& b = kPoints[s % kPoints.size()];
+      const Vec3 x = b[0] * p[t.v[0]] + b[1] * p[t.v[1]] + b[2] * p[t.v[2]];
+      const Vec3 r = closest[s] - x;
+      const double w = area_vector(p, t).norm() / kPoints.size() / out_area;
+      e += w * r.squaredNorm();
+      if (!num || r.norm() > params.max_residual_edge_multiple * longest_edge(p, t)) continue;
+      for (int k = 0; k < 3; ++k) {
+        (*num)[t.v[k]] += w * b[k] * r;
+        (*den)[t.v[k]] += w * b[k];
+      }
+    }
+    for (std::size_t s = 0; s < in_samples.size(); ++s) {
+      const FanTriangle& t = out_tris[hit[s].primitive];
+      const Vec3 r = in_samples[s] - hit[s].point;
+      e += in_weight[s] * r.squaredNorm();
+      if (!num || r.norm() > params.max_residual_edge_multiple * longest_edge(p, t)) continue;
+      const auto b = barycentric(hit[s].point, p[t.v[0]], p[t.v[1]], p[t.v[2]]);
+      for (int k = 0; k < 3; ++k) {
+        (*num)[t.v[k]] += in_weight[s] * b[k] * r;
+        (*den)[t.v[k]] += in_weight[s] * b[k];
+      }
+    }
+    return e;
+  };
+
+  // A face may turn by max_turn_deg per step and shrink to min_area_ratio of its area before the
+  // step, and never face away from where it faced before the fit (no flip).
+  std::vector<Vec3> area_step(out_tris.size());
+  auto face_ok = [&](Index i) {
+    const Vec3 a = area_vector(output.positions, out_tris[i]);
+    const double n0 = area_step[i].norm(), n1 = a.norm();
+    if (n1 < params.min_area_ratio * n0) return false;
+    if (area0[i].squaredNorm() > 0.0 && !(a.dot(area0[i]) > 0.0)) return false;
+    return n0 == 0.0 || a.dot(area_step[i]) >= cos_turn * n0 * n1;
+  };
+
+  // docs/metrics.md §6b, as the collapse applies it (collapse_checks.cpp): from a face's
+  // centroid, the nearest input triangle facing its way is at most twice as far as the nearest
+  // of either way, plus the tolerance.
+  auto faces_input = [&](Index f, double tol) {
+    const auto fv = output.face_vertices(f);
+    Vec3 c = Vec3::Zero(), av = Vec3::Zero();
+    for (std::size_t i = 0; i < fv.size(); ++i) {
+      const Vec3& a = output.positions[fv[i]];
+      c += a;
+      av += a.cross(output.positions[fv[i + 1 == fv.size() ? 0 : i + 1]]);
+    }
+    c /= static_cast<double>(fv.size());
+    const NearestHit any = in_bvh.nearest(c);
+    if (any.primitive == kInvalidIndex) return true;
+    const double reach = 2.0 * std::sqrt(any.distance_sq) + tol;
+    const double min_dot = 1e-3 * av.norm();  // as the collapse: near-perpendicular does not agree
+    const NearestHit agreeing = in_bvh.nearest_if(
+        c, [&](Index t) { return ref.normal[t].dot(av) >= min_dot; }, kInvalidIndex, reach * reach);
+    return agreeing.primitive != kInvalidIndex && std::sqrt(agreeing.distance_sq) <= reach;
+  };
+  // Per face, the slack it is held to: the collapse's where it passes with it, eval's (twice
+  // that) where only eval's holds, none where even eval's fails before the fit (already counted).
+  std::vector<double> face_tol(output.num_faces(), -1.0);
+  for (Index f = 0; f < output.num_faces(); ++f) {
+    if (faces_input(f, orientation_tol)) face_tol[f] = orientation_tol;
+    else if (faces_input(f, 2.0 * orientation_tol)) face_tol[f] = 2.0 * orientation_tol;
+  }
+  // A face that fails even eval's rule before the fit is an input face kept as it was (eval counts
+  // it apart, in flipped_faces_kept, only while its corners stay where they are): its vertices stay.
+  std::vector<std::uint8_t> fixed(nv, 0);
+  if (params.fixed_vertices && params.fixed_vertices->size() == nv) fixed = *params.fixed_vertices;
+  for (Index f = 0; f < output.num_faces(); ++f)
+    if (face_tol[f] < 0.0)
+      for (Index v : output.face_vertices(f)) fixed[v] = 1;
+
+  std::vector<Vec3> num(nv);
+  std::vector<double> den(nv);
+  for (int it = 0; it < params.iterations; ++it) {
+    std::fill(num.begin(), num.end(), Vec3::Zero());
+    std::fill(den.begin(), den.end(), 0.0);
+    const double e = energy(&num, &den);
+    if (it == 0) result.energy_before = e;
+    const std::vector<Vec3> before = output.positions;
+    for (std::size_t i = 0; i < out_tris.size(); ++i) area_step[i] = area_vector(before, out_tris[i]);
+    std::vector<std::uint8_t> moved(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (fixed[v] || !(den[v] > 0.0) || vertex_tris[v].empty()) continue;
+      Vec3 d = params.step * num[v] / den[v];
+      double shortest = std::numeric_limits<double>::infinity();
+      for (Index i : vertex_tris[v])
+        for (int k = 0; k < 3; ++k)
+          if (out_tris[i].v[k] != v) shortest = std::min(shortest, (before[out_tris[i].v[k]] - before[v]).norm());
+      const double cap = params.max_step_edge_fraction * shortest;
+      if (d.norm() > cap) d *= cap / d.norm();
+      if (d.squaredNorm() == 0.0) continue;
+      output.positions[v] = before[v] + d;
+      moved[v] = 1;
+    }
+    // Undo the moves of every vertex of a face that turned or shrank too much, until none does
+    // (undoing only returns vertices to where they were, so this ends).
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (std::size_t i = 0; i < out_tris.size(); ++i) {
+        if (face_ok(static_cast<Index>(i))) continue;
+        for (Index v : out_tris[i].v)
+          if (moved[v]) {
+            output.positions[v] = before[v];
+            moved[v] = 0;
+            ++result.refused_moves;
+            changed = true;
+          }
+      }
+      if (changed) continue;  // the cheap checks first; the orientation once they hold
+      for (Index f = 0; f < output.num_faces(); ++f) {
+        const auto fv = output.face_vertices(f);
+        if (face_tol[f] < 0.0 || std::none_of(fv.begin(), fv.end(), [&](Index v) { return moved[v] != 0; }) ||
+            faces_input(f, face_tol[f]))
+          continue;
+        for (Index v : fv)
+          if (moved[v]) {
+            output.positions[v] = before[v];
+            moved[v] = 0;
+            ++result.refused_moves;
+            changed = true;
+          }
+      }
+    }
+  }
+  result.energy_after = params.iterations > 0 ? energy(nullptr, nullptr) : 0.0;
+  for (std::size_t v = 0; v < nv; ++v) result.moved_vertices += output.positions[v] != start[v];
+  return result;
+}
+
+}  // namespace quadlod

@@ -1,0 +1,69 @@
+// quadlod — the final fit of the output's vertices to the input surface (issue 24; docs/cluster_collapse.md,
+// "Surface fit").
+//
+// The collapse places every cluster by its quadric (volume-constrained where it can, Lindstrom &
+// Turk 1998): that minimises the vertex's distances to the input's planes, not the distance
+// between the two surfaces, which is what Chamfer and Hausdorff measure and what a posed LOD
+// carries into every frame (on the ram at 0.2 the per-frame Chamfer was 4.8 % above Single's
+// while the bind-pose Chamfer tied). The fit moves each output vertex a few damped Gauss–Newton
+// steps on the two-sided Chamfer energy between the output and the input:
+//
+//   E = Σ_{s on output} w_s d(s, M_in)² + Σ_{a on input} w_a d(a, M_out)²,
+//
+// fixed samples (4 barycentric points of every output fan triangle, 1 or 4 of every input one,
+// weights = area share) whose residuals
+// are spread onto the triangle's corners by their barycentric coordinates; each vertex moves by
+// the weighted mean of its residuals (a lumped step, which does not overshoot when neighbours move together). Connectivity, UVs and
+// every other attribute stay as they are; a step that would turn an incident face by more than
+// `max_turn_deg`, shrink it below `min_area_ratio` of its area, or turn it away from the way it
+// faced before the fit (a flip), or leave it facing away from the input surface by eval's rule
+// (docs/metrics.md §6b), is undone for the face's vertices, and no vertex moves farther
+// than `max_step_edge_fraction` of its shortest edge in one step.
+#pragma once
+
+#include "quadlod/mesh.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace quadlod {
+
+struct SurfaceFitParams {
+  /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
+  int iterations = 4;
+  /// Fraction of the computed move that is made (damping; 1 = the full lumped step).
+  double step = 1.0;
+  /// A vertex moves at most this fraction of its shortest incident edge per step, so no face can
+  /// degenerate in one step.
+  double max_step_edge_fraction = 0.25;
+  /// A sample whose closest point is farther than this multiple of its triangle's longest edge
+  /// belongs to another part (an eye in its socket, a leg against the body) and is not used.
+  double max_residual_edge_multiple = 1.0;
+  /// An incident face may turn by at most this angle (degrees) in one step; against its normal
+  /// before the fit it may turn by anything short of a flip (90°).
+  double max_turn_deg = 30.0;
+  /// An incident face keeps at least this fraction of its area before the step.
+  double min_area_ratio = 0.5;
+  /// The orientation guard (docs/metrics.md §6b, as the collapse applies it): a face that faced
+  /// the input before the fit must still face it, with this slack (× the input's longest bbox
+  /// side; ClusterCollapseParams::orientation_tolerance, half of eval's).
+  double orientation_tolerance = 5e-4;
+  /// Per output vertex, 1 = it does not move (the pipeline passes the vertices on non-manifold
+  /// edges, UV seams and material borders, whose lines eval holds to the input's: `seams_torn`,
+  /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
+  const std::vector<std::uint8_t>* fixed_vertices = nullptr;
+  int threads = 0;
+};
+
+struct SurfaceFitResult {
+  double energy_before = 0.0;  ///< E at the start (input units², area-weighted means summed)
+  double energy_after = 0.0;   ///< E at the end, with the same samples
+  Index moved_vertices = 0;    ///< vertices whose position changed
+  Index refused_moves = 0;     ///< vertex moves undone by the turn / area / step guards (summed over steps)
+};
+
+/// Fits output.positions to the surface of `input` (both pass check_layout(); faces of any
+/// degree, fan-triangulated). Deterministic for any thread count.
+SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const SurfaceFitParams& params = {});
+
+}  // namespace quadlod

@@ -1,0 +1,149 @@
+// Tests of src/post/surface_fit.h (issue 24: the final fit of the output's vertices to the input
+// surface): known answers on planes and cylinders, the guards, determinism, and the pipeline hook.
+#include "post/surface_fit.h"
+
+#include "quadlod/generators.h"
+#include "quadlod/metrics.h"
+#include "quadlod/simplify.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace quadlod {
+namespace {
+
+double radius_xy(const Vec3& p) { return std::hypot(p.x(), p.y()); }
+
+TEST(SurfaceFit, OffsetPlaneReturnsToThePlaneInOneStep) {
+  // Every residual of both directions is (0, 0, -0.01): the lumped step moves every vertex by it.
+  const PolyMesh input = make_grid(8, 8);
+  PolyMesh output = make_grid(2, 2);
+  for (Vec3& p : output.positions) p.z() += 0.01;
+  SurfaceFitParams params;
+  params.iterations = 1;
+  const SurfaceFitResult r = fit_to_surface(input, output, params);
+  for (const Vec3& p : output.positions) EXPECT_NEAR(p.z(), 0.0, 1e-12);
+  EXPECT_NEAR(r.energy_before, 2 * 0.01 * 0.01, 1e-12);  // both directions' mean of d² = 1e-4
+  EXPECT_NEAR(r.energy_after, 0.0, 1e-20);
+  EXPECT_EQ(r.moved_vertices, output.positions.size());
+  EXPECT_EQ(r.refused_moves, 0u);
+  // The grid's x, y are where they were: a plane's residuals have no tangential part.
+  const PolyMesh grid = make_grid(2, 2);
+  for (std::size_t v = 0; v < grid.positions.size(); ++v)
+    EXPECT_NEAR((output.positions[v] - grid.positions[v]).head<2>().norm(), 0.0, 1e-12);
+}
+
+TEST(SurfaceFit, CoarseCylinderMovesOutwardBetweenTheCircleAndTheCircumscribedPolygon) {
+  // An 8-sided prism with its vertices on the circle lies inside the cylinder: chords cut in.
+  // The Chamfer optimum puts the vertices outside the circle, but no farther than the polygon
+  // whose edges touch it (radius r / cos(π/8)), where every chord would lie outside.
+  const double r = 0.5;
+  const PolyMesh input = make_cylinder(96, 8, r, 1.0);
+  PolyMesh output = make_cylinder(8, 2, r, 1.0);
+  const SurfaceFitResult fit = fit_to_surface(input, output);
+  EXPECT_LT(fit.energy_after, 0.25 * fit.energy_before);
+  EXPECT_EQ(fit.refused_moves, 0u);
+  for (const Vec3& p : output.positions) {
+    EXPECT_GT(radius_xy(p), r);
+    EXPECT_LT(radius_xy(p), r / std::cos(std::numbers::pi / 8));
+  }
+  // Symmetric input and output: every vertex of one ring ends at the same radius.
+  for (Index v = 1; v < 8; ++v) EXPECT_NEAR(radius_xy(output.positions[v]), radius_xy(output.positions[0]), 1e-9);
+  // And the Chamfer distance that evaluate() measures drops.
+  PolyMesh unfitted = make_cylinder(8, 2, r, 1.0);
+  EXPECT_LT(evaluate(input, output).chamfer, 0.5 * evaluate(input, unfitted).chamfer);
+}
+
+TEST(SurfaceFit, RaisedVertexComesDownUnlessTheTurnGuardRefuses) {
+  const PolyMesh input = make_grid(16, 16);
+  const PolyMesh raised = [] {
+    PolyMesh m = make_grid(4, 4);
+    m.positions[12].z() = 0.2;  // the centre vertex (row 2, column 2 of 5 × 5)
+    return m;
+  }();
+  ASSERT_NEAR(raised.positions[12].x(), 0.5, 1e-12);
+  PolyMesh output = raised;
+  SurfaceFitParams params;
+  params.iterations = 16;
+  fit_to_surface(input, output, params);
+  // From 0.2 to within 0.005 of the plane (the step contracts by about 0.7; the neighbours, pulled
+  // up while the faces were tilted, come back down with it).
+  EXPECT_LT(std::abs(output.positions[12].z()), 0.005);
+  for (const Vec3& p : output.positions) EXPECT_LT(std::abs(p.z()), 0.005);
+  // A turn limit below any rotation: every move that turns a face is undone, and the plane's
+  // vertices that only the raised faces pull on stay too.
+  output = raised;
+  params.max_turn_deg = 1e-3;
+  const SurfaceFitResult refused = fit_to_surface(input, output, params);
+  EXPECT_GT(refused.refused_moves, 0u);
+  EXPECT_DOUBLE_EQ(output.positions[12].z(), 0.2);
+}
+
+TEST(SurfaceFit, FaceThatAlreadyFacesAwayKeepsItsVertices) {
+  // A reversed face lying on the input faces away from it (eval counts such a face apart only
+  // while it is exactly as it was): its four corners stay; the other five vertices come down.
+  const PolyMesh input = make_grid(8, 8);
+  PolyMesh output = make_grid(2, 2);
+  for (Vec3& p : output.positions) p.z() += 1e-4;  // within the orientation slack of the plane
+  const Index b = output.face_begin(0);
+  std::reverse(output.corner_vertex.begin() + b, output.corner_vertex.begin() + output.face_end(0));
+  const std::vector<Index> reversed(output.corner_vertex.begin() + b, output.corner_vertex.begin() + output.face_end(0));
+  SurfaceFitParams params;
+  params.iterations = 1;
+  const SurfaceFitResult r = fit_to_surface(input, output, params);
+  EXPECT_EQ(r.moved_vertices, 5u);
+  for (Index v = 0; v < output.positions.size(); ++v) {
+    const bool kept = std::find(reversed.begin(), reversed.end(), v) != reversed.end();
+    EXPECT_NEAR(output.positions[v].z(), kept ? 1e-4 : 0.0, 1e-12) << "vertex " << v;
+  }
+}
+
+TEST(SurfaceFit, StepNeverExceedsTheEdgeFraction) {
+  const PolyMesh input = make_grid(8, 8);
+  PolyMesh output = make_grid(2, 2);
+  for (Vec3& p : output.positions) p.z() += 1.0;  // far above: each step is capped at 0.25 · 0.5
+  SurfaceFitParams params;
+  params.iterations = 1;
+  params.max_residual_edge_multiple = 10.0;  // the residual (1.0) must count for this test
+  fit_to_surface(input, output, params);
+  for (const Vec3& p : output.positions) EXPECT_NEAR(p.z(), 1.0 - 0.125, 1e-12);
+}
+
+TEST(SurfaceFit, SameResultForAnyThreadCount) {
+  const PolyMesh input = make_torus(48, 24);
+  PolyMesh a = make_torus(12, 6), b = a;
+  SurfaceFitParams params;
+  params.threads = 1;
+  fit_to_surface(input, a, params);
+  params.threads = 3;
+  fit_to_surface(input, b, params);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  for (std::size_t v = 0; v < a.positions.size(); ++v) EXPECT_EQ(a.positions[v], b.positions[v]);
+}
+
+TEST(SurfaceFit, SimplifyFitsByDefaultAndLowersTheChamferDistance) {
+  const PolyMesh input = make_torus(48, 24);
+  SimplifyOptions options;
+  options.ratio = 0.3;
+  options.threads = 1;
+  const SimplifyResult fitted = simplify(input, options);
+  ASSERT_TRUE(fitted.error.empty()) << fitted.error;
+  ASSERT_TRUE(fitted.report.contains("surface_fit"));
+  EXPECT_LT(fitted.report["surface_fit"]["energy_after"].get<double>(), fitted.report["surface_fit"]["energy_before"].get<double>());
+  options.surface_fit_iterations = 0;
+  const SimplifyResult plain = simplify(input, options);
+  ASSERT_TRUE(plain.error.empty()) << plain.error;
+  EXPECT_FALSE(plain.report.contains("surface_fit"));
+  // Same connectivity (the fit moves vertices only), lower Chamfer distance, no face flipped.
+  EXPECT_EQ(fitted.mesh.face_offsets, plain.mesh.face_offsets);
+  EXPECT_EQ(fitted.mesh.corner_vertex, plain.mesh.corner_vertex);
+  const EvalResult ef = evaluate(input, fitted.mesh), ep = evaluate(input, plain.mesh);
+  EXPECT_LT(ef.chamfer, ep.chamfer);
+  EXPECT_EQ(ef.flipped_faces, 0u);
+}
+
+}  // namespace
+}  // namespace quadlod
