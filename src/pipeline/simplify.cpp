@@ -698,6 +698,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     SurfaceFitParams fp;
     fp.iterations = options.surface_fit_iterations;
     fp.threads = options.threads;
+    fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
                              {"energy_before", fit.energy_before},

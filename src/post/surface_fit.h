@@ -25,6 +25,8 @@
 
 namespace quadlod {
 
+struct SurfaceReference;  // post/cluster_collapse.h
+
 struct SurfaceFitParams {
   /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
   int iterations = 4;
@@ -46,6 +48,9 @@ struct SurfaceFitParams {
   /// side; ClusterCollapseParams::orientation_tolerance, half of eval's).
   double orientation_tolerance = 5e-4;
   int threads = 0;
+  /// make_surface_reference(input, threads), borrowed (the run's: its BVH is ~5 % of a 1M-face
+  /// run); nullptr: built here.
+  const SurfaceReference* surface = nullptr;
 };
 
 struct SurfaceFitResult {
