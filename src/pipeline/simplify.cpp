@@ -732,6 +732,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
           for (Index v : out_conn.edge_vertices[e]) on_line[v] = 1;
       fp.fixed_vertices = &on_line;
     }
+    fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
                              {"energy_before", fit.energy_before},

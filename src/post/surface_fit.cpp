@@ -70,7 +70,9 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
   if (in_tris.empty() || out_tris.empty()) return result;
   // The input surface as eval triangulates it, with unit normals: the reference of the closest
   // points and of the orientation guard (the collapse's, cluster_collapse.h).
-  const SurfaceReference ref = make_surface_reference(input, params.threads);
+  SurfaceReference own;
+  if (!params.surface) own = make_surface_reference(input, params.threads);
+  const SurfaceReference& ref = params.surface ? *params.surface : own;
   const TriangleBvh& in_bvh = ref.bvh;
   const double orientation_tol = params.orientation_tolerance * ref.longest_side;
   const std::size_t nv = output.positions.size();
@@ -191,10 +193,12 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
   // Per face, the slack it is held to: the collapse's where it passes with it, eval's (twice
   // that) where only eval's holds, none where even eval's fails before the fit (already counted).
   std::vector<double> face_tol(output.num_faces(), -1.0);
-  for (Index f = 0; f < output.num_faces(); ++f) {
-    if (faces_input(f, orientation_tol)) face_tol[f] = orientation_tol;
-    else if (faces_input(f, 2.0 * orientation_tol)) face_tol[f] = 2.0 * orientation_tol;
-  }
+  parallel_chunks(std::size_t(output.num_faces()), params.threads, 4096, [&](std::size_t begin, std::size_t end, std::size_t) {
+    for (Index f = Index(begin); f < Index(end); ++f) {
+      if (faces_input(f, orientation_tol)) face_tol[f] = orientation_tol;
+      else if (faces_input(f, 2.0 * orientation_tol)) face_tol[f] = 2.0 * orientation_tol;
+    }
+  });
   // A face that fails even eval's rule before the fit is an input face kept as it was (eval counts
   // it apart, in flipped_faces_kept, only while its corners stay where they are): its vertices stay.
   std::vector<std::uint8_t> fixed(nv, 0);
@@ -205,11 +209,15 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
 
   std::vector<Vec3> num(nv);
   std::vector<double> den(nv);
-  for (int it = 0; it < params.iterations; ++it) {
+  std::vector<std::uint8_t> faces_ok(output.num_faces()), put_back(nv);
+  double last_energy = 0.0;
+  bool settled = false;  // the last step moved no vertex: the next would start where it did
+  for (int it = 0; it < params.iterations && !settled; ++it) {
     std::fill(num.begin(), num.end(), Vec3::Zero());
     std::fill(den.begin(), den.end(), 0.0);
     const double e = energy(&num, &den);
     if (it == 0) result.energy_before = e;
+    last_energy = e;
     const std::vector<Vec3> before = output.positions;
     for (std::size_t i = 0; i < out_tris.size(); ++i) area_step[i] = area_vector(before, out_tris[i]);
     std::vector<std::uint8_t> moved(nv, 0);
@@ -241,22 +249,35 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
           }
       }
       if (changed) continue;  // the cheap checks first; the orientation once they hold
+      // The face-by-face sweep below, with every face's test run first on all threads against
+      // the positions as they are; a face whose vertex an earlier face of the sweep put back is
+      // tested again there, so the sweep decides as if it ran alone.
+      auto needs_test = [&](Index f) {
+        const auto fv = output.face_vertices(f);
+        return face_tol[f] >= 0.0 && std::any_of(fv.begin(), fv.end(), [&](Index v) { return moved[v] != 0; });
+      };
+      parallel_chunks(std::size_t(output.num_faces()), params.threads, 4096, [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (Index f = Index(begin); f < Index(end); ++f) faces_ok[f] = !needs_test(f) || faces_input(f, face_tol[f]);
+      });
+      std::fill(put_back.begin(), put_back.end(), 0);
       for (Index f = 0; f < output.num_faces(); ++f) {
         const auto fv = output.face_vertices(f);
-        if (face_tol[f] < 0.0 || std::none_of(fv.begin(), fv.end(), [&](Index v) { return moved[v] != 0; }) ||
-            faces_input(f, face_tol[f]))
-          continue;
+        const bool again = std::any_of(fv.begin(), fv.end(), [&](Index v) { return put_back[v] != 0; });
+        if (!needs_test(f) || (again ? faces_input(f, face_tol[f]) : faces_ok[f])) continue;
         for (Index v : fv)
           if (moved[v]) {
             output.positions[v] = before[v];
             moved[v] = 0;
+            put_back[v] = 1;
             ++result.refused_moves;
             changed = true;
           }
       }
     }
+    // Nothing moved (every residual zero, or every move refused): the same positions again.
+    settled = std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; });
   }
-  result.energy_after = params.iterations > 0 ? energy(nullptr, nullptr) : 0.0;
+  result.energy_after = params.iterations == 0 ? 0.0 : settled ? last_energy : energy(nullptr, nullptr);
   for (std::size_t v = 0; v < nv; ++v) result.moved_vertices += output.positions[v] != start[v];
   return result;
 }

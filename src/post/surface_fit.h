@@ -28,6 +28,8 @@
 
 namespace quadlod {
 
+struct SurfaceReference;  // post/cluster_collapse.h
+
 struct SurfaceFitParams {
   /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
   int iterations = 4;
@@ -53,6 +55,9 @@ struct SurfaceFitParams {
   /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
   const std::vector<std::uint8_t>* fixed_vertices = nullptr;
   int threads = 0;
+  /// make_surface_reference(input, threads), borrowed (the run's: its BVH is ~5 % of a 1M-face
+  /// run); nullptr: built here.
+  const SurfaceReference* surface = nullptr;
 };
 
 struct SurfaceFitResult {
