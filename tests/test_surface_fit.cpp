@@ -36,6 +36,20 @@ TEST(SurfaceFit, OffsetPlaneReturnsToThePlaneInOneStep) {
     EXPECT_NEAR((output.positions[v] - grid.positions[v]).head<2>().norm(), 0.0, 1e-12);
 }
 
+TEST(SurfaceFit, AnOutputOnTheInputSurfaceStaysBitForBitAfterOneStep) {
+  // A coarser grid in the input's plane, with coordinates that are not binary fractions: its
+  // closest points are the sample points up to rounding, which must move nothing (the fit once
+  // wrote 2.1e-19 for the 0 of a flat grid's boundary vertices).
+  const PolyMesh input = make_grid(30, 20, 0.7, 0.3);
+  PolyMesh output = make_grid(10, 5, 0.7, 0.3);
+  const std::vector<Vec3> before = output.positions;
+  const SurfaceFitResult r = fit_to_surface(input, output, {});
+  EXPECT_EQ(output.positions, before);
+  EXPECT_EQ(r.moved_vertices, 0u);
+  EXPECT_EQ(r.steps, 1);  // a step that moves nothing ends the fit
+  EXPECT_EQ(r.energy_after, r.energy_before);
+}
+
 TEST(SurfaceFit, CoarseCylinderMovesOutwardBetweenTheCircleAndTheCircumscribedPolygon) {
   // An 8-sided prism with its vertices on the circle lies inside the cylinder: chords cut in.
   // The Chamfer optimum puts the vertices outside the circle, but no farther than the polygon

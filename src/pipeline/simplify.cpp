@@ -735,6 +735,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
+                             {"steps", fit.steps},
                              {"energy_before", fit.energy_before},
                              {"energy_after", fit.energy_after},
                              {"moved_vertices", fit.moved_vertices},

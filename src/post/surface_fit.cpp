@@ -139,9 +139,12 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
       const Vec3 r = closest[s] - x;
       const double w = area_vector(p, t).norm() / kPoints.size() / out_area;
       e += w * r.squaredNorm();
-      if (!num || r.norm() > params.max_residual_edge_multiple * longest_edge(p, t)) continue;
+      if (!num) continue;
+      const double edge = longest_edge(p, t), len = r.norm();
+      if (len > params.max_residual_edge_multiple * edge) continue;
+      const bool rounding = len <= params.min_residual_edge_fraction * edge;
       for (int k = 0; k < 3; ++k) {
-        (*num)[t.v[k]] += w * b[k] * r;
+        if (!rounding) (*num)[t.v[k]] += w * b[k] * r;
         (*den)[t.v[k]] += w * b[k];
       }
     }
@@ -149,10 +152,13 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
       const FanTriangle& t = out_tris[hit[s].primitive];
       const Vec3 r = in_samples[s] - hit[s].point;
       e += in_weight[s] * r.squaredNorm();
-      if (!num || r.norm() > params.max_residual_edge_multiple * longest_edge(p, t)) continue;
+      if (!num) continue;
+      const double edge = longest_edge(p, t), len = r.norm();
+      if (len > params.max_residual_edge_multiple * edge) continue;
+      const bool rounding = len <= params.min_residual_edge_fraction * edge;
       const auto b = barycentric(hit[s].point, p[t.v[0]], p[t.v[1]], p[t.v[2]]);
       for (int k = 0; k < 3; ++k) {
-        (*num)[t.v[k]] += in_weight[s] * b[k] * r;
+        if (!rounding) (*num)[t.v[k]] += in_weight[s] * b[k] * r;
         (*den)[t.v[k]] += in_weight[s] * b[k];
       }
     }
@@ -218,6 +224,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     const double e = energy(&num, &den);
     if (it == 0) result.energy_before = e;
     last_energy = e;
+    ++result.steps;
     const std::vector<Vec3> before = output.positions;
     for (std::size_t i = 0; i < out_tris.size(); ++i) area_step[i] = area_vector(before, out_tris[i]);
     std::vector<std::uint8_t> moved(nv, 0);

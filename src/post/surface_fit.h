@@ -41,6 +41,11 @@ struct SurfaceFitParams {
   /// A sample whose closest point is farther than this multiple of its triangle's longest edge
   /// belongs to another part (an eye in its socket, a leg against the body) and is not used.
   double max_residual_edge_multiple = 1.0;
+  /// A residual shorter than this fraction of its triangle's longest edge counts as zero (it
+  /// still weighs in the vertex's mean): closest points carry rounding (1e-19 on a flat grid,
+  /// where the fit otherwise moved 504 of a 250k-face LOD's vertices by that and wrote
+  /// "2.1e-19" for 0), and a millionth of an edge is below float32's resolution of it.
+  double min_residual_edge_fraction = 1e-6;
   /// An incident face may turn by at most this angle (degrees) in one step; against its normal
   /// before the fit it may turn by anything short of a flip (90°).
   double max_turn_deg = 30.0;
@@ -63,6 +68,7 @@ struct SurfaceFitParams {
 struct SurfaceFitResult {
   double energy_before = 0.0;  ///< E at the start (input units², area-weighted means summed)
   double energy_after = 0.0;   ///< E at the end, with the same samples
+  int steps = 0;               ///< steps taken (fewer than asked once a step moves nothing)
   Index moved_vertices = 0;    ///< vertices whose position changed
   Index refused_moves = 0;     ///< vertex moves undone by the turn / area / step guards (summed over steps)
 };
