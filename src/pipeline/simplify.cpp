@@ -733,11 +733,12 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       fp.fixed_vertices = &on_line;
     }
     fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
+    fp.measure_after = false;
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
                              {"steps", fit.steps},
                              {"energy_before", fit.energy_before},
-                             {"energy_after", fit.energy_after},
+                             {"energy_last_step", fit.energy_last_step},
                              {"moved_vertices", fit.moved_vertices},
                              {"refused_moves", fit.refused_moves}};
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;

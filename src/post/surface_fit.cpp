@@ -284,7 +284,8 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     // Nothing moved (every residual zero, or every move refused): the same positions again.
     settled = std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; });
   }
-  result.energy_after = params.iterations == 0 ? 0.0 : settled ? last_energy : energy(nullptr, nullptr);
+  result.energy_last_step = last_energy;
+  if (params.measure_after) result.energy_after = params.iterations == 0 ? 0.0 : settled ? last_energy : energy(nullptr, nullptr);
   for (std::size_t v = 0; v < nv; ++v) result.moved_vertices += output.positions[v] != start[v];
   return result;
 }

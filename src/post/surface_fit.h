@@ -60,6 +60,9 @@ struct SurfaceFitParams {
   /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
   const std::vector<std::uint8_t>* fixed_vertices = nullptr;
   int threads = 0;
+  /// Evaluate E once more after the last step (energy_after). The pipeline does not: it is a
+  /// whole evaluation, a fifth of the fit's queries, for a figure of the report.
+  bool measure_after = true;
   /// make_surface_reference(input, threads), borrowed (the run's: its BVH is ~5 % of a 1M-face
   /// run); nullptr: built here.
   const SurfaceReference* surface = nullptr;
@@ -67,7 +70,8 @@ struct SurfaceFitParams {
 
 struct SurfaceFitResult {
   double energy_before = 0.0;  ///< E at the start (input units², area-weighted means summed)
-  double energy_after = 0.0;   ///< E at the end, with the same samples
+  double energy_after = 0.0;   ///< E at the end, with the same samples (measure_after; else 0)
+  double energy_last_step = 0.0;  ///< E at the start of the last step taken
   int steps = 0;               ///< steps taken (fewer than asked once a step moves nothing)
   Index moved_vertices = 0;    ///< vertices whose position changed
   Index refused_moves = 0;     ///< vertex moves undone by the turn / area / step guards (summed over steps)
