@@ -138,7 +138,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                 "Keep merged vertices on hard edges (else they follow their quadric, which weighs sharp edges heavily)")
       ->group("Features");
   sub->add_option("--surface-fit", p.surface_fit_iterations,
-                  "Steps of the final fit of the output's vertices to the input surface (0 = keep the collapse's placements)")
+                  "Steps of the final fit of the output's vertices to the input surface (0 = keep the collapse's placements; 4 = the measured setting, lower Chamfer, ~75 % more time)")
       ->check(CLI::Range(0, 100))->capture_default_str()->group("Features");
   sub->add_option("--hard-angle", p.hard_angle_deg, "Dihedral angle (degrees) from which an edge is a hard edge")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Features");
