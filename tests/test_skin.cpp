@@ -221,6 +221,109 @@ TEST(SkinTransfer, TakesTheWeightsOfItsOwnSide) {
   }
 }
 
+TEST(SkinPoses, RangeOfMotionTurnsEveryJointByTheAngleAboutSpreadAxes) {
+  const SkinnedMesh tube = make_bending_tube(8, 12, 3);
+  const Skeleton& s = tube.rig.skeleton;
+  const auto poses = range_of_motion_poses(s, 16, 30.0);
+  ASSERT_EQ(poses.size(), 16u);
+  std::vector<Vec3> axes;
+  for (const auto& pose : poses) {
+    ASSERT_EQ(pose.size(), s.joints.size());
+    for (Index j = 0; j < s.num_joints(); ++j) {
+      const Quat turn = s.joints[j].rest.rotation.conjugate() * pose[j].rotation;  // in the joint's frame
+      EXPECT_NEAR(Eigen::AngleAxisd(turn).angle() * 180.0 / std::numbers::pi, 30.0, 1e-9) << "joint " << j;
+      EXPECT_EQ(pose[j].translation, s.joints[j].rest.translation);
+      EXPECT_EQ(pose[j].scale, s.joints[j].rest.scale);
+      if (j == 0) axes.push_back(Eigen::AngleAxisd(turn).axis());
+    }
+  }
+  // Sixteen different axes, none closer than 25° to another (a Fibonacci spiral of 16 points
+  // spreads them about 50° apart), and the same poses on a second call.
+  for (std::size_t a = 0; a < axes.size(); ++a)
+    for (std::size_t b = a + 1; b < axes.size(); ++b) EXPECT_LT(axes[a].dot(axes[b]), std::cos(25.0 * std::numbers::pi / 180.0));
+  const auto again = range_of_motion_poses(s, 16, 30.0);
+  for (std::size_t k = 0; k < poses.size(); ++k)
+    for (Index j = 0; j < s.num_joints(); ++j) EXPECT_EQ(again[k][j].rotation.coeffs(), poses[k][j].rotation.coeffs());
+  // They bend the tube: a vertex blended between two bones leaves the rigid motion of either.
+  const std::vector<Mat4> m = skinning_matrices(s, global_joint_matrices(s, poses[3]));
+  const PolyMesh posed = pose_mesh(tube.mesh, m);
+  Index bent = 0;
+  for (Index v = 0; v < tube.mesh.num_vertices(); ++v) {
+    if (tube.mesh.skin.influences(v) < 2) continue;
+    const Index j = tube.mesh.skin.joint[tube.mesh.skin.offsets[v]];
+    bent += (posed.positions[v] - (m[j] * tube.mesh.positions[v].homogeneous()).head<3>()).norm() > 1e-6;
+  }
+  EXPECT_GT(bent, 0u);
+}
+
+// An n×n grid of quads over [x0, x0 + size] × [0, size] at height z, facing +Z, every vertex on `joint`.
+void add_plate(PolyMesh& m, std::vector<std::vector<Influence>>& weights, double x0, double size, double z, Index n,
+               Index joint) {
+  const Index base = m.num_vertices();
+  for (Index j = 0; j <= n; ++j)
+    for (Index i = 0; i <= n; ++i) {
+      m.add_vertex(Vec3(x0 + size * i / n, size * j / n, z));
+      weights.push_back({{joint, 1.0}});
+    }
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const Index a = base + j * (n + 1) + i;
+      m.add_face({a, a + 1, a + n + 2, a + n + 1});
+    }
+}
+
+TEST(SkinTransfer, APartKeepsToTheInputPartItCameFrom) {
+  // The ram's eye: an eyeball (joint 0) half covered, 0.003 above it, by an eyelid (joint 1, a
+  // part of its own) facing the same way. A reduced eyeball 0.005 above the ball is nearer to the
+  // lid where the lid is; it must still take the ball's weights everywhere, or its faces stretch
+  // between the two bones. The lid's own reduction keeps to the lid.
+  PolyMesh source;
+  std::vector<std::vector<Influence>> w;
+  add_plate(source, w, 0.0, 1.0, 0.0, 8, 0);     // the ball
+  add_plate(source, w, 0.5, 0.5, 0.008, 4, 1);   // the lid over a quarter of it (x, y in [0.5, 1] × [0, 0.5])
+  source.skin = make_skin_weights(w);
+  PolyMesh target;
+  std::vector<std::vector<Influence>> unused;
+  add_plate(target, unused, 0.0, 1.0, 0.005, 2, 0);  // the reduced ball: 9 vertices, 4 of them under the lid
+  add_plate(target, unused, 0.5, 0.5, 0.0085, 1, 0);  // the reduced lid
+  const SkinTransferResult kept = transfer_skin_weights(source, target);
+  EXPECT_EQ(kept.parts, 2u);
+  EXPECT_EQ(kept.parts_matched, 2u);
+  for (Index v = 0; v < target.num_vertices(); ++v) {
+    ASSERT_EQ(kept.skin.influences(v), 1u) << "vertex " << v;
+    EXPECT_EQ(kept.skin.joint[kept.skin.offsets[v]], v < 9 ? 0u : 1u) << "vertex " << v;
+  }
+  // Without the rule the ball's vertices under the lid take the lid's bone: the case it is for.
+  SkinTransferParams nearest;
+  nearest.keep_parts = false;
+  const SkinTransferResult loose = transfer_skin_weights(source, target, nearest);
+  Index on_lid = 0;
+  for (Index v = 0; v < 9; ++v) on_lid += loose.skin.joint[loose.skin.offsets[v]] == 1u;
+  EXPECT_EQ(on_lid, 4u);  // (0.5, 0), (1, 0), (0.5, 0.5), (1, 0.5): 0.003 from the lid, 0.005 from the ball
+}
+
+TEST(SkinTransfer, APartJoinedFromTwoProjectsOntoBoth) {
+  // Two plates side by side on different bones, and one plate over both (a reducer that joined
+  // them): no part is near enough to all of it, so each vertex takes the weights under it.
+  PolyMesh source;
+  std::vector<std::vector<Influence>> w;
+  add_plate(source, w, 0.0, 1.0, 0.0, 4, 0);
+  add_plate(source, w, 1.0, 1.0, 0.0, 4, 1);
+  source.skin = make_skin_weights(w);
+  PolyMesh target;
+  std::vector<std::vector<Influence>> unused;
+  add_plate(target, unused, 0.0, 2.0, 0.0, 4, 0);  // x = 0, 0.5, …, 2: edges of 0.5, 1 from the far plate
+  const SkinTransferResult r = transfer_skin_weights(source, target);
+  EXPECT_EQ(r.parts, 1u);
+  EXPECT_EQ(r.parts_matched, 0u);
+  for (Index v = 0; v < target.num_vertices(); ++v) {
+    const double x = target.positions[v].x();
+    if (x == 1.0) continue;  // on the seam: either
+    ASSERT_EQ(r.skin.influences(v), 1u) << "vertex " << v;
+    EXPECT_EQ(r.skin.joint[r.skin.offsets[v]], x < 1.0 ? 0u : 1u) << "vertex " << v;
+  }
+}
+
 // The known-answer test: a tube whose halves follow two bones, reduced, keeps every vertex's
 // weights within the input's range — at most the input's influences, only its joints, and the weight
 // of joint 1 between the input's weights one ring below and one ring above the vertex's height.

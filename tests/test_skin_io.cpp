@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 namespace quadlod {
@@ -137,6 +138,29 @@ TEST_F(SkinIo, CliSimplifiesAndEvaluatesASkinnedTube) {
   const auto bad = testing::run_cli("-q eval '" + lod + "' '" + lod + "' --animation", dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("needs a skinned input"), std::string::npos) << bad.err;
+}
+
+// The CLI measures a skinned reduction in 16 poses by default (docs/skinning.md, "Poses"): the
+// rig's animation frames when it has any (the tube's 12), range-of-motion poses when it has none.
+TEST_F(SkinIo, CliPosesTheRigsFramesOrItsRangeOfMotion) {
+  const SkinnedMesh tube = make_bending_tube(12, 16, 2);
+  Rig still = tube.rig;
+  still.animations.clear();
+  ASSERT_TRUE(write_skinned_glb(tube.mesh, tube.rig, dir / "walking.glb").ok());
+  ASSERT_TRUE(write_skinned_glb(tube.mesh, still, dir / "still.glb").ok());
+  auto poses_used = [&](const std::string& input, const std::string& extra) {
+    const std::string report = (dir / "report.json").string();
+    const auto r = testing::run_cli("-q simplify '" + (dir / input).string() + "' -o '" + (dir / "lod.glb").string() +
+                                        "' --ratio 0.5 --report '" + report + "' " + extra,
+                                    dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(report);
+    return nlohmann::json::parse(in)["options"]["skin_poses"].get<int>();
+  };
+  EXPECT_EQ(poses_used("walking.glb", ""), int(tube.rig.animations[0].frame_times().size()));
+  EXPECT_EQ(poses_used("still.glb", ""), 16);
+  EXPECT_EQ(poses_used("walking.glb", "--skin-pose-source range --skin-poses 5"), 5);
+  EXPECT_EQ(poses_used("walking.glb", "--skin-poses 0"), 0);
 }
 
 #ifdef QUADLOD_CORPUS_DIR

@@ -2,6 +2,8 @@
 // surface): known answers on planes and cylinders, the guards, determinism, and the pipeline hook.
 #include "post/surface_fit.h"
 
+#include "post/cluster_collapse.h"
+
 #include "quadlod/generators.h"
 #include "quadlod/metrics.h"
 #include "quadlod/simplify.h"
@@ -69,6 +71,48 @@ TEST(SurfaceFit, CoarseCylinderMovesOutwardBetweenTheCircleAndTheCircumscribedPo
   // And the Chamfer distance that evaluate() measures drops.
   PolyMesh unfitted = make_cylinder(8, 2, r, 1.0);
   EXPECT_LT(evaluate(input, output).chamfer, 0.5 * evaluate(input, unfitted).chamfer);
+}
+
+TEST(SurfaceFit, TheHausdorffGuardHoldsVerticesToTheirDistanceAtFractionZero) {
+  // The prism of the test above with max_vertex_distance_fraction = 0: every vertex is on the
+  // cylinder, so none may leave it, and the outward moves are all refused by the guard.
+  const PolyMesh input = make_cylinder(96, 8, 0.5, 1.0);
+  PolyMesh output = make_cylinder(8, 2, 0.5, 1.0);
+  const std::vector<Vec3> before = output.positions;
+  SurfaceFitParams params;
+  params.max_vertex_distance_fraction = 0.0;
+  const SurfaceFitResult fit = fit_to_surface(input, output, params);
+  EXPECT_EQ(output.positions, before);
+  EXPECT_EQ(fit.refused_far, before.size());
+  EXPECT_EQ(fit.refused_moves, fit.refused_far);
+  // At the default the same vertices move out, but no farther than the guard's reach: the chord
+  // sag r (1 − cos(π/8)) the fit starts from, as its longest residual measures it.
+  PolyMesh free = make_cylinder(8, 2, 0.5, 1.0);
+  const SurfaceFitResult fitted = fit_to_surface(input, free);
+  EXPECT_GT(fitted.start_reach, 0.0);
+  EXPECT_LE(fitted.start_reach, 0.5 * (1.0 - std::cos(std::numbers::pi / 8)) + 1e-12);
+  for (const Vec3& p : free.positions) EXPECT_LE(radius_xy(p) - 0.5, fitted.start_reach + 1e-12);
+}
+
+TEST(SurfaceFit, NoVertexEndsFartherThanItsReachOnAReducedMesh) {
+  // A real LOD (a torus reduced to a quarter, vertices placed by quadrics off the surface): after
+  // four steps no vertex is farther from the input than it was or than the starting reach.
+  const PolyMesh input = make_torus(48, 24, 1.0, 0.35);
+  SimplifyOptions o;
+  o.ratio = 0.25;
+  const SimplifyResult r = simplify(input, o);
+  ASSERT_TRUE(r.ok()) << r.error;
+  PolyMesh output = r.mesh;
+  const SurfaceReference ref = make_surface_reference(input, 1);
+  std::vector<double> before(output.positions.size());
+  for (std::size_t v = 0; v < before.size(); ++v) before[v] = std::sqrt(ref.bvh.nearest(output.positions[v]).distance_sq);
+  SurfaceFitParams params;
+  params.surface = &ref;
+  const SurfaceFitResult fit = fit_to_surface(input, output, params);
+  EXPECT_GT(fit.moved_vertices, 0u);
+  for (std::size_t v = 0; v < before.size(); ++v)
+    EXPECT_LE(std::sqrt(ref.bvh.nearest(output.positions[v]).distance_sq), std::max(before[v], fit.start_reach) + 1e-12)
+        << "vertex " << v;
 }
 
 TEST(SurfaceFit, RaisedVertexComesDownUnlessTheTurnGuardRefuses) {

@@ -6,12 +6,13 @@
 #include "quadlod/scene.h"
 #include "util/progress.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace quadlod::cli {
 
 int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
-                        const SimplifyOptions& options, bool per_mesh) {
+                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses) {
   SceneFormat format;
   if (!scene_format_from_path(output, format))
     return fail(output + ": unknown output format (use .obj, .ply, .off, .glb, .fbx or .dae)");
@@ -25,6 +26,11 @@ int simplify_scene_file(const std::string& input, const std::string& output, con
   SceneSimplifyParams params;
   params.options = options;
   params.per_mesh = per_mesh;
+  // The skinned meshes' weights index the scene's rig, and pose_mesh with its skinning matrices
+  // poses them where eval --animation does (docs/skinning.md, "Scenes"); unskinned meshes ignore them.
+  const bool skinned = std::any_of(in.scene.meshes.begin(), in.scene.meshes.end(),
+                                   [](const SceneMesh& m) { return !m.mesh.skin.empty(); });
+  if (skinned && !in.scene.rig.empty()) params.options.skin_poses = chosen_poses(in.scene.rig, poses);
   clock = Stopwatch();
   SceneSimplifyResult r = simplify_scene(in.scene, params);
   if (!r.ok()) return fail(input + ": " + r.error);

@@ -3,6 +3,8 @@
 // and printing; all work happens in the library.
 #pragma once
 
+#include "skin_cli.h"
+
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
@@ -45,9 +47,10 @@ Command add_lod(CLI::App& app, const GlobalOptions& global);
 Command add_batch(CLI::App& app, const GlobalOptions& global);
 
 /// `quadlod simplify` on a scene (either side not OBJ / PLY / OFF): read_scene, simplify_scene,
-/// write_scene; prints one summary line (cmd_scene.cpp).
+/// write_scene; prints one summary line (cmd_scene.cpp). A skinned scene's meshes are reduced
+/// in `poses` of its rig as well as at the bind pose (deformation-sensitive quadrics).
 int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
-                        const SimplifyOptions& options, bool per_mesh);
+                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses);
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

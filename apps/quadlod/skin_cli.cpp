@@ -109,4 +109,19 @@ std::vector<std::vector<Mat4>> rig_poses(const Rig& rig, Index max_poses) {
   return poses;
 }
 
+std::vector<std::vector<Mat4>> chosen_poses(const Rig& rig, const SkinPoseChoice& choice) {
+  bool animated = false;
+  for (const Animation& a : rig.animations) animated = animated || !a.frame_times().empty();
+  const bool range = choice.source == "range" || (choice.source == "auto" && !animated);
+  return range ? range_poses(rig, choice.count, choice.angle_deg) : rig_poses(rig, choice.count);
+}
+
+std::vector<std::vector<Mat4>> range_poses(const Rig& rig, Index count, double angle_deg) {
+  std::vector<std::vector<Mat4>> poses;
+  const Skeleton& s = rig.skeleton;
+  for (const auto& local : range_of_motion_poses(s, count, angle_deg))
+    poses.push_back(skinning_matrices(s, global_joint_matrices(s, local)));
+  return poses;
+}
+
 }  // namespace quadlod::cli

@@ -42,4 +42,17 @@ std::string remap_joints(PolyMesh& mesh, const Skeleton& from, const Skeleton& t
 /// are more. For SimplifyOptions::skin_poses. 0 or no animation: none.
 std::vector<std::vector<Mat4>> rig_poses(const Rig& rig, Index max_poses);
 
+/// Skinning matrices of `count` range-of-motion poses of the rig's skeleton (range_of_motion_poses).
+std::vector<std::vector<Mat4>> range_poses(const Rig& rig, Index count, double angle_deg);
+
+/// --skin-poses, --skin-pose-source, --skin-pose-angle.
+struct SkinPoseChoice {
+  Index count = 16;
+  std::string source = "auto";  ///< "animation", "range", or "auto" (range for a rig without animated frames)
+  double angle_deg = 30.0;
+};
+
+/// The skinning matrices `choice` asks for (rig_poses or range_poses).
+std::vector<std::vector<Mat4>> chosen_poses(const Rig& rig, const SkinPoseChoice& choice);
+
 }  // namespace quadlod::cli

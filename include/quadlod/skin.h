@@ -94,6 +94,13 @@ struct SkinnedMesh {
 /// The local pose of every joint when nothing is animated (their `rest` transforms).
 std::vector<JointTransform> rest_pose(const Skeleton& skeleton);
 
+/// Poses that need no animation, for deformation-sensitive reduction of any rig (docs/skinning.md,
+/// "Poses"): pose k turns every joint by `angle_deg` about axis k of `count` axes spread evenly over
+/// the sphere (a Fibonacci spiral) in the joint's own frame, on top of its rest rotation. The same
+/// skeleton, count and angle always give the same poses.
+std::vector<std::vector<JointTransform>> range_of_motion_poses(const Skeleton& skeleton, Index count,
+                                                               double angle_deg = 30.0);
+
 /// The local pose at `time` (seconds): each channel interpolated (linear: lerp for translation and
 /// scale, shortest-arc slerp for rotation; step: the last key at or before `time`), clamped to
 /// the first / last key outside its range; joints and properties no channel drives keep `rest`.
@@ -152,12 +159,29 @@ struct SkinTransferParams {
   double max_normal_angle_deg = 90.0;
   /// How far (fraction of the source's bounding-box diagonal) the same-side triangle may be.
   double max_side_distance = 0.05;
+  /// Parts (connected pieces) keep to their part: every target part is matched to the source
+  /// part most of its vertices lie closest to (by area), and its vertices are projected onto that
+  /// part only. Without it, the ram's head vertices at the rim of an eye socket took the eyeball's
+  /// weights (45 faces of quadlod's LOD at 0.2, 38 of Single's, joined an eye vertex to head
+  /// vertices; the input has none), and in the walk those faces stretched as the eyes turned:
+  /// both LODs' worst per-frame distance, 0.059 against 0.024–0.037 at the bind pose
+  /// (docs/skinning.md). The candidates are the source parts nearest to at least
+  /// `min_part_share` of the target part's vertices (by area); the part keeps to the candidate
+  /// its vertices lie closest to (area-weighted mean squared distance: the ram's eyeball is
+  /// overlapped by two eyelid shells, and half its vertices lie nearest to a lid), unless one of
+  /// its vertices lies farther from it than `max_part_distance_edges` of the part's mean edge
+  /// length (a part a reducer joined from two), and then it projects onto every part.
+  bool keep_parts = true;
+  double min_part_share = 0.2;
+  double max_part_distance_edges = 1.0;
 };
 
 struct SkinTransferResult {
   SkinWeights skin;             ///< one entry per target vertex
   Index same_side = 0;          ///< vertices projected onto a triangle facing their way
-  Index nearest_only = 0;       ///< vertices that took the plain closest triangle
+  Index nearest_only = 0;       ///< vertices that took the plain closest triangle (of their part)
+  Index parts = 0;              ///< connected parts of the target
+  Index parts_matched = 0;      ///< of those, projected onto one source part (keep_parts)
   double max_distance = 0.0;    ///< largest projection distance (source units)
   double mean_distance = 0.0;
 };

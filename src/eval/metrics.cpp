@@ -527,6 +527,9 @@ nlohmann::json to_json(const EvalResult& r) {
     j["hausdorff_upper"] = num(r.hausdorff_upper);
     j["hausdorff_converged"] = r.hausdorff_converged;
     j["hausdorff_queries"] = r.hausdorff_queries;
+    // Where the distance is attained (input units), and on which mesh: what to look at.
+    j["hausdorff_point"] = {r.hausdorff_point.x(), r.hausdorff_point.y(), r.hausdorff_point.z()};
+    j["hausdorff_on"] = r.hausdorff_point_on_output ? "output" : "input";
   }
   j["qpr"] = num(r.qpr);
   j["qpr_rule"] = r.qpr_rule;

@@ -740,7 +740,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"energy_before", fit.energy_before},
                              {"energy_last_step", fit.energy_last_step},
                              {"moved_vertices", fit.moved_vertices},
-                             {"refused_moves", fit.refused_moves}};
+                             {"refused_moves", fit.refused_moves},
+                             {"refused_far", fit.refused_far}};
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
   }
   // Summary.
@@ -848,6 +849,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"hard_angle_deg", options.hard_angle_deg},
       {"place_on_hard_edges", options.place_on_hard_edges},
       {"surface_fit_iterations", options.surface_fit_iterations},
+      {"skin_poses", input.skin.empty() ? 0 : options.skin_poses.size()},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
       {"later_round_time_fraction", options.later_round_time_fraction},

@@ -33,6 +33,9 @@ struct SurfaceReference;  // post/cluster_collapse.h
 struct SurfaceFitParams {
   /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
   int iterations = 4;
+  /// Samples per output fan triangle: 4 (its centroid and its midpoint sub-triangles') or 1 (the
+  /// centroid).
+  int output_points = 4;
   /// Fraction of the computed move that is made (damping; 1 = the full lumped step).
   double step = 1.0;
   /// A vertex moves at most this fraction of its shortest incident edge per step, so no face can
@@ -49,6 +52,11 @@ struct SurfaceFitParams {
   /// An incident face may turn by at most this angle (degrees) in one step; against its normal
   /// before the fit it may turn by anything short of a flip (90°).
   double max_turn_deg = 30.0;
+  /// The Hausdorff guard: a step may not leave a vertex farther from the input than it was
+  /// before the fit, or than this fraction of the farthest point before the fit (the longest
+  /// residual of the first step, either direction, or vertex distance), whichever is more. 1: no
+  /// vertex ends farther from the input than the Hausdorff distance the fit started from.
+  double max_vertex_distance_fraction = 1.0;
   /// An incident face keeps at least this fraction of its area before the step.
   double min_area_ratio = 0.5;
   /// The orientation guard (docs/metrics.md §6b, as the collapse applies it): a face that faced
@@ -74,7 +82,9 @@ struct SurfaceFitResult {
   double energy_last_step = 0.0;  ///< E at the start of the last step taken
   int steps = 0;               ///< steps taken (fewer than asked once a step moves nothing)
   Index moved_vertices = 0;    ///< vertices whose position changed
-  Index refused_moves = 0;     ///< vertex moves undone by the turn / area / step guards (summed over steps)
+  Index refused_moves = 0;     ///< vertex moves undone by any guard (summed over steps)
+  Index refused_far = 0;       ///< of those, by the Hausdorff guard (max_vertex_distance_fraction)
+  double start_reach = 0.0;    ///< the farthest point before the fit, as the guard measures it
 };
 
 /// Fits output.positions to the surface of `input` (both pass check_layout(); faces of any

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 namespace quadlod {
 
@@ -62,6 +63,22 @@ std::vector<JointTransform> rest_pose(const Skeleton& skeleton) {
   pose.reserve(skeleton.joints.size());
   for (const Joint& j : skeleton.joints) pose.push_back(j.rest);
   return pose;
+}
+
+std::vector<std::vector<JointTransform>> range_of_motion_poses(const Skeleton& skeleton, Index count,
+                                                               double angle_deg) {
+  std::vector<std::vector<JointTransform>> poses;
+  const double golden_angle = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  const double angle = angle_deg * std::numbers::pi / 180.0;
+  for (Index k = 0; k < count; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / count, r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Vec3 axis(r * std::cos(k * golden_angle), r * std::sin(k * golden_angle), z);
+    const Quat turn(Eigen::AngleAxisd(angle, axis.normalized()));
+    std::vector<JointTransform> pose = rest_pose(skeleton);
+    for (JointTransform& t : pose) t.rotation = (t.rotation * turn).normalized();
+    poses.push_back(std::move(pose));
+  }
+  return poses;
 }
 
 namespace {

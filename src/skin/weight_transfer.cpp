@@ -41,6 +41,33 @@ Vec3 barycentric(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
   return Vec3(u, v, w) / s;
 }
 
+// Connected parts: vertices joined by faces (union-find), numbered by their first vertex; a
+// vertex used by no face is its own part.
+std::vector<Index> vertex_parts(const PolyMesh& m, Index* count) {
+  std::vector<Index> parent(m.num_vertices());
+  for (Index v = 0; v < m.num_vertices(); ++v) parent[v] = v;
+  auto find = [&](Index x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (Index f = 0; f < m.num_faces(); ++f) {
+    const auto vs = m.face_vertices(f);
+    for (std::size_t i = 1; i < vs.size(); ++i) {
+      const Index a = find(vs[0]), b = find(vs[i]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<Index> part(m.num_vertices(), kInvalidIndex), id(m.num_vertices(), kInvalidIndex);
+  Index n = 0;
+  for (Index v = 0; v < m.num_vertices(); ++v) {
+    const Index r = find(v);
+    if (id[r] == kInvalidIndex) id[r] = n++;
+    part[v] = id[r];
+  }
+  *count = n;
+  return part;
+}
+
 }  // namespace
 
 SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
@@ -50,6 +77,9 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
   std::vector<std::array<Vec3, 3>> triangles;
   std::vector<std::array<Index, 3>> corners;
   std::vector<Vec3> normals;
+  std::vector<Index> triangle_part;
+  Index source_parts = 0;
+  const std::vector<Index> source_part = vertex_parts(source, &source_parts);
   for (Index f = 0; f < source.num_faces(); ++f) {
     const auto vs = source.face_vertices(f);
     const Vec3 n = face_normal(source, f);
@@ -57,6 +87,7 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
       triangles.push_back({source.positions[vs[0]], source.positions[vs[i]], source.positions[vs[i + 1]]});
       corners.push_back({vs[0], vs[i], vs[i + 1]});
       normals.push_back(n);
+      triangle_part.push_back(source_part[vs[0]]);
     }
   }
   const TriangleBvh bvh(triangles);
@@ -71,25 +102,114 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
   const double cos_limit = std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0);
   const double side_limit = params.max_side_distance * bounding_box(source).diagonal();
 
-  std::vector<std::vector<Influence>> per_vertex(target.num_vertices());
-  double sum_distance = 0.0;
-  Index hint = kInvalidIndex;
-  for (Index v = 0; v < target.num_vertices(); ++v) {
+  // Per source part, its triangles (local id → source triangle) and their BVH (keep_parts).
+  std::vector<TriangleBvh> part_bvh;
+  std::vector<std::vector<Index>> part_triangles;
+  // The closest point of the source (part == kInvalidIndex) or of one part to target vertex v:
+  // among the triangles facing v's way first, then any (`same_side` says which); the primitive
+  // is a source triangle id, `hint` a previous answer in the same search set.
+  auto project = [&](Index v, Index part, Index& hint, bool* same_side) {
+    const TriangleBvh& search = part == kInvalidIndex ? bvh : part_bvh[part];
+    auto source_triangle = [&](Index t) { return part == kInvalidIndex ? t : part_triangles[part][t]; };
     const Vec3& p = target.positions[v];
     const double len = vertex_normal[v].norm();
     NearestHit hit;
     if (len > 0.0) {
       const Vec3 n = vertex_normal[v] / len;
-      hit = bvh.nearest_if(p, [&](Index t) { return normals[t].dot(n) > cos_limit; }, hint, side_limit * side_limit);
+      hit = search.nearest_if(p, [&](Index t) { return normals[source_triangle(t)].dot(n) > cos_limit; }, hint,
+                              side_limit * side_limit);
     }
-    if (hit.primitive == kInvalidIndex) {
-      hit = bvh.nearest(p, hint);
-      ++result.nearest_only;
-    } else {
-      ++result.same_side;
+    *same_side = hit.primitive != kInvalidIndex;
+    if (!*same_side) hit = search.nearest(p, hint);
+    if (hit.primitive != kInvalidIndex) {
+      hint = hit.primitive;
+      hit.primitive = source_triangle(hit.primitive);
     }
+    return hit;
+  };
+
+  // keep_parts (skin.h): the source parts that hold at least min_part_share of a target part's
+  // closest points (by vertex area) are its candidates; it keeps to the candidate its vertices
+  // lie closest to (area-weighted mean squared distance: the ram's eyeball is overlapped by two
+  // eyelid shells, and half its vertices lie nearest to a lid), unless a vertex lies farther from
+  // that one than max_part_distance_edges mean edge lengths of the part (a part a reducer joined
+  // from two: no one input part lies under all of it). kInvalidIndex = every part.
+  Index target_parts = 0;
+  const std::vector<Index> target_part = vertex_parts(target, &target_parts);
+  result.parts = target_parts;
+  std::vector<Index> matched(target_parts, kInvalidIndex);
+  if (params.keep_parts && source_parts > 1 && !triangles.empty()) {
+    part_triangles.resize(source_parts);
+    for (Index t = 0; t < triangles.size(); ++t) part_triangles[triangle_part[t]].push_back(t);
+    part_bvh.resize(source_parts);
+    for (Index c = 0; c < source_parts; ++c) {
+      std::vector<std::array<Vec3, 3>> tris;
+      for (Index t : part_triangles[c]) tris.push_back(triangles[t]);
+      if (!tris.empty()) part_bvh[c] = TriangleBvh(tris);
+    }
+    // Each target part's mean edge length (every face side counted once per face).
+    std::vector<double> part_edge(target_parts, 0.0), part_sides(target_parts, 0.0);
+    for (Index f = 0; f < target.num_faces(); ++f) {
+      const auto vs = target.face_vertices(f);
+      for (std::size_t i = 0; i < vs.size(); ++i) {
+        part_edge[target_part[vs[i]]] += (target.positions[vs[i]] - target.positions[vs[(i + 1) % vs.size()]]).norm();
+        part_sides[target_part[vs[i]]] += 1.0;
+      }
+    }
+    for (Index c = 0; c < target_parts; ++c) part_edge[c] = part_sides[c] > 0.0 ? part_edge[c] / part_sides[c] : 0.0;
+    std::vector<std::vector<std::pair<Index, double>>> votes(target_parts);  // (source part, area)
+    std::vector<std::vector<Index>> members(target_parts);
+    Index hint = kInvalidIndex;
+    bool same_side = false;
+    for (Index v = 0; v < target.num_vertices(); ++v) {
+      members[target_part[v]].push_back(v);
+      const NearestHit hit = project(v, kInvalidIndex, hint, &same_side);
+      if (hit.primitive == kInvalidIndex) continue;
+      votes[target_part[v]].push_back({triangle_part[hit.primitive], vertex_normal[v].norm()});
+    }
+    for (Index c = 0; c < target_parts; ++c) {
+      auto& vc = votes[c];
+      std::sort(vc.begin(), vc.end());
+      double total = 0.0;
+      for (const auto& [part, area] : vc) total += area;
+      if (!(total > 0.0)) continue;
+      double best = INFINITY, best_far = 0.0;
+      for (std::size_t i = 0; i < vc.size();) {
+        double share = 0.0;
+        std::size_t j = i;
+        for (; j < vc.size() && vc[j].first == vc[i].first; ++j) share += vc[j].second;
+        if (share >= params.min_part_share * total) {
+          double sum = 0.0, far = 0.0;
+          Index h = kInvalidIndex;
+          for (Index v : members[c]) {
+            const NearestHit hit = project(v, vc[i].first, h, &same_side);
+            sum += vertex_normal[v].norm() * hit.distance_sq;
+            far = std::max(far, hit.distance_sq);
+          }
+          if (sum < best) {
+            best = sum;
+            best_far = far;
+            matched[c] = vc[i].first;
+          }
+        }
+        i = j;
+      }
+      const double reach = params.max_part_distance_edges * part_edge[c];
+      if (!(best_far <= reach * reach)) matched[c] = kInvalidIndex;
+      result.parts_matched += matched[c] != kInvalidIndex;
+    }
+  }
+
+  std::vector<std::vector<Influence>> per_vertex(target.num_vertices());
+  double sum_distance = 0.0;
+  Index hint = kInvalidIndex;
+  std::vector<Index> part_hint(part_bvh.size(), kInvalidIndex);
+  for (Index v = 0; v < target.num_vertices(); ++v) {
+    const Index part = matched[target_part[v]];
+    bool same_side = false;
+    const NearestHit hit = project(v, part, part == kInvalidIndex ? hint : part_hint[part], &same_side);
+    ++(same_side ? result.same_side : result.nearest_only);
     if (hit.primitive == kInvalidIndex) continue;  // empty source: no weights
-    hint = hit.primitive;
     const auto& c = corners[hit.primitive];
     const auto& t = triangles[hit.primitive];
     const Vec3 bary = barycentric(hit.point, t[0], t[1], t[2]);
