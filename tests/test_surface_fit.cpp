@@ -7,6 +7,7 @@
 #include "quadlod/generators.h"
 #include "quadlod/metrics.h"
 #include "quadlod/simplify.h"
+#include "quadlod/skin.h"
 
 #include <gtest/gtest.h>
 
@@ -182,13 +183,12 @@ TEST(SurfaceFit, SameResultForAnyThreadCount) {
   for (std::size_t v = 0; v < a.positions.size(); ++v) EXPECT_EQ(a.positions[v], b.positions[v]);
 }
 
-TEST(SurfaceFit, SimplifyFitsWhenAskedAndLowersTheChamferDistance) {
+TEST(SurfaceFit, SimplifyFitsByDefaultAndLowersTheChamferDistance) {
   const PolyMesh input = make_torus(48, 24);
   SimplifyOptions options;
   options.ratio = 0.3;
   options.threads = 1;
-  EXPECT_EQ(options.surface_fit_iterations, 0);  // off by default (simplify.h: its time)
-  options.surface_fit_iterations = 4;
+  EXPECT_EQ(options.surface_fit_iterations, 2);  // on by default since session 15 (simplify.h)
   const SimplifyResult fitted = simplify(input, options);
   ASSERT_TRUE(fitted.error.empty()) << fitted.error;
   ASSERT_TRUE(fitted.report.contains("surface_fit"));
@@ -203,6 +203,44 @@ TEST(SurfaceFit, SimplifyFitsWhenAskedAndLowersTheChamferDistance) {
   const EvalResult ef = evaluate(input, fitted.mesh), ep = evaluate(input, plain.mesh);
   EXPECT_LT(ef.chamfer, ep.chamfer);
   EXPECT_EQ(ef.flipped_faces, 0u);
+}
+
+TEST(SurfaceFit, InPosesOnlyVerticesOnOneBoneMove) {
+  // A two-bone tube reduced in its animation's poses: a vertex whose faces blend the bones was
+  // placed for every pose, and the fit (bind pose only) leaves it there; vertices on one bone move.
+  const SkinnedMesh tube = make_bending_tube(16, 24, 2);
+  SimplifyOptions options;
+  options.ratio = 0.5;
+  options.threads = 1;
+  const Skeleton& s = tube.rig.skeleton;
+  for (double t : tube.rig.animations[0].frame_times())
+    options.skin_poses.push_back(skinning_matrices(s, global_joint_matrices(s, sample_pose(s, tube.rig.animations[0], t))));
+  const SimplifyResult fitted = simplify(tube.mesh, options);
+  options.surface_fit_iterations = 0;
+  const SimplifyResult plain = simplify(tube.mesh, options);
+  ASSERT_TRUE(fitted.ok() && plain.ok()) << fitted.error << plain.error;
+  ASSERT_EQ(fitted.mesh.corner_vertex, plain.mesh.corner_vertex);
+  const SkinWeights& w = plain.mesh.skin;
+  auto joint = [&](Index v) { return w.influences(v) == 1 ? w.joint[w.offsets[v]] : kInvalidIndex; };
+  std::vector<char> blended(plain.mesh.num_vertices(), 0);
+  for (Index f = 0; f < plain.mesh.num_faces(); ++f) {
+    const auto fv = plain.mesh.face_vertices(f);
+    for (Index v : fv)
+      if (joint(v) == kInvalidIndex || joint(v) != joint(fv[0]))
+        for (Index u : fv) blended[u] = 1;
+  }
+  Index held = 0, moved = 0;
+  for (Index v = 0; v < plain.mesh.num_vertices(); ++v) {
+    const bool same = fitted.mesh.positions[v] == plain.mesh.positions[v];
+    if (blended[v]) {
+      EXPECT_TRUE(same) << "blended vertex " << v;
+      ++held;
+    } else {
+      moved += !same;
+    }
+  }
+  EXPECT_GT(held, 0u);
+  EXPECT_GT(moved, 0u);
 }
 
 }  // namespace
