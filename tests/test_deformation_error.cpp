@@ -92,6 +92,33 @@ TEST(HausdorffBound, EvaluateReportsTheBracketAndIgnoresTheSeed) {
   EXPECT_LE(a.hausdorff_upper - a.hausdorff, 1e-6 + 1e-12);
 }
 
+TEST(HausdorffBound, TheJsonNamesThePointAndTheMeshItLiesOn) {
+  // A 4×4 grid against itself with its centre vertex raised by 0.3: the farthest point is that
+  // vertex, on the output; the other way round it is on the input.
+  const PolyMesh flat = make_grid(4, 4);
+  PolyMesh raised = flat;
+  Index centre = 0;
+  for (Index v = 0; v < raised.num_vertices(); ++v)
+    if ((raised.positions[v] - Vec3(0.5, 0.5, 0.0)).norm() < 1e-9) centre = v;
+  raised.positions[centre].z() = 0.3;
+  EvalParams p;
+  p.samples = 2000;
+  p.curve_samples = 2000;
+  p.hausdorff_tolerance = 1e-7;
+  for (const bool raised_is_output : {true, false}) {
+    const EvalResult r = raised_is_output ? evaluate(flat, raised, p) : evaluate(raised, flat, p);
+    ASSERT_TRUE(r.ok()) << r.error;
+    const nlohmann::json j = to_json(r);
+    ASSERT_TRUE(j.contains("hausdorff_point"));
+    EXPECT_EQ(j["hausdorff_on"], raised_is_output ? "output" : "input");
+    const Vec3 at(j["hausdorff_point"][0].get<double>(), j["hausdorff_point"][1].get<double>(),
+                  j["hausdorff_point"][2].get<double>());
+    EXPECT_NEAR((at - raised.positions[centre]).norm(), 0.0, 1e-6);
+  }
+  // A default (sampled) evaluation keeps its JSON as it was.
+  EXPECT_FALSE(to_json(evaluate(flat, raised, EvalParams{})).contains("hausdorff_point"));
+}
+
 TEST(PoseQuadrics, APulledBackQuadricMeasuresThePosedPoint) {
   Quadric q = Quadric::plane(Vec3(0.2, -0.1, 0.4), Vec3(1, 2, 2).normalized());
   q += Quadric::plane(Vec3(0, 0, 1), Vec3(0, 0, 1));

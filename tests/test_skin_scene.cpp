@@ -8,9 +8,14 @@
 #include "quadlod/skin_io.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
 
 namespace quadlod {
 namespace {
@@ -124,6 +129,20 @@ TEST_F(SkinScene, CliReducesASkinnedSceneAndKeepsEverySkin) {
     EXPECT_EQ(m.mesh.skin.check(m.mesh.num_vertices()), "") << m.name;
   }
   EXPECT_EQ(skinned, 2u);
+  // The skinned meshes were reduced in the rig's animation frames (docs/skinning.md, "Poses"),
+  // the static one at its bind pose only.
+  const fs::path report = dir / "report.json";
+  const auto again = testing::run_cli(
+      "-q simplify '" + in.string() + "' -o '" + out.string() + "' --ratio 0.5 --report '" + report.string() + "'", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  std::ifstream file(report);
+  const nlohmann::json j = nlohmann::json::parse(file);
+  const int frames = int(two_skinned_tubes().rig.animations[0].frame_times().size());
+  std::map<std::string, int> poses;
+  for (const auto& m : j["meshes"]) poses[m["name"].get<std::string>()] = m["simplify"]["options"]["skin_poses"].get<int>();
+  EXPECT_EQ(poses["left"], std::min(frames, 16));
+  EXPECT_EQ(poses["right"], std::min(frames, 16));
+  EXPECT_EQ(poses["static"], 0);
 }
 
 TEST_F(SkinScene, BlenderImportsBothSkinnedMeshesOnOneArmature) {
