@@ -7,7 +7,8 @@
 // The closest triangle is looked for first among those facing p's way (source face normal within
 // max_normal_angle_deg of p's area-weighted normal): two surfaces close to each other (a leg
 // against the belly, upper and lower lip) usually face apart, and a vertex must follow the bones
-// of its own surface.
+// of its own surface, and only on the input part (connected piece) its own part of the LOD lies
+// on (docs/skinning.md, "Parts keep to their part").
 #include "quadlod/skin.h"
 
 #include "geometry/bvh.h"
@@ -68,56 +69,61 @@ std::vector<Index> vertex_parts(const PolyMesh& m, Index* count) {
   return part;
 }
 
-}  // namespace
-
-SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
-                                         const SkinTransferParams& params) {
-  SkinTransferResult result;
-  // Fan triangles of the source, each remembering its corners and its polygon's normal.
+// The source as projection target: its fan triangles with their corners, polygon normals and
+// part, one BVH over all and (keep_parts) one per part.
+struct SourceSurface {
   std::vector<std::array<Vec3, 3>> triangles;
   std::vector<std::array<Index, 3>> corners;
   std::vector<Vec3> normals;
   std::vector<Index> triangle_part;
-  Index source_parts = 0;
-  const std::vector<Index> source_part = vertex_parts(source, &source_parts);
-  for (Index f = 0; f < source.num_faces(); ++f) {
-    const auto vs = source.face_vertices(f);
-    const Vec3 n = face_normal(source, f);
-    for (std::size_t i = 1; i + 1 < vs.size(); ++i) {
-      triangles.push_back({source.positions[vs[0]], source.positions[vs[i]], source.positions[vs[i + 1]]});
-      corners.push_back({vs[0], vs[i], vs[i + 1]});
-      normals.push_back(n);
-      triangle_part.push_back(source_part[vs[0]]);
+  Index parts = 0;
+  TriangleBvh all;
+  std::vector<TriangleBvh> part_bvh;              ///< empty unless built
+  std::vector<std::vector<Index>> part_triangles;  ///< a part's local triangle id → source triangle
+  double cos_limit = 0.0, side_limit_sq = 0.0;
+
+  SourceSurface(const PolyMesh& source, const SkinTransferParams& params) {
+    const std::vector<Index> part = vertex_parts(source, &parts);
+    for (Index f = 0; f < source.num_faces(); ++f) {
+      const auto vs = source.face_vertices(f);
+      const Vec3 n = face_normal(source, f);
+      for (std::size_t i = 1; i + 1 < vs.size(); ++i) {
+        triangles.push_back({source.positions[vs[0]], source.positions[vs[i]], source.positions[vs[i + 1]]});
+        corners.push_back({vs[0], vs[i], vs[i + 1]});
+        normals.push_back(n);
+        triangle_part.push_back(part[vs[0]]);
+      }
+    }
+    all = TriangleBvh(triangles);
+    cos_limit = std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0);
+    const double side_limit = params.max_side_distance * bounding_box(source).diagonal();
+    side_limit_sq = side_limit * side_limit;
+  }
+
+  void build_part_bvhs() {
+    part_triangles.assign(parts, {});
+    for (Index t = 0; t < triangles.size(); ++t) part_triangles[triangle_part[t]].push_back(t);
+    part_bvh.resize(parts);
+    for (Index c = 0; c < parts; ++c) {
+      std::vector<std::array<Vec3, 3>> tris;
+      for (Index t : part_triangles[c]) tris.push_back(triangles[t]);
+      if (!tris.empty()) part_bvh[c] = TriangleBvh(tris);
     }
   }
-  const TriangleBvh bvh(triangles);
-  const Index max_influences = params.max_influences > 0 ? params.max_influences : source.skin.max_influences();
 
-  // Area-weighted vertex normals of the target.
-  std::vector<Vec3> vertex_normal(target.num_vertices(), Vec3::Zero());
-  for (Index f = 0; f < target.num_faces(); ++f) {
-    const Vec3 area = face_area_vector(target, f);
-    for (Index v : target.face_vertices(f)) vertex_normal[v] += area;
-  }
-  const double cos_limit = std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0);
-  const double side_limit = params.max_side_distance * bounding_box(source).diagonal();
-
-  // Per source part, its triangles (local id → source triangle) and their BVH (keep_parts).
-  std::vector<TriangleBvh> part_bvh;
-  std::vector<std::vector<Index>> part_triangles;
-  // The closest point of the source (part == kInvalidIndex) or of one part to target vertex v:
-  // among the triangles facing v's way first, then any (`same_side` says which); the primitive
-  // is a source triangle id, `hint` a previous answer in the same search set.
-  auto project = [&](Index v, Index part, Index& hint, bool* same_side) {
-    const TriangleBvh& search = part == kInvalidIndex ? bvh : part_bvh[part];
+  /// The closest point to p of the whole source (part == kInvalidIndex) or of one part: among
+  /// the triangles facing `area_normal`'s way first (within side_limit), then any; `same_side`
+  /// says which. The primitive is a source triangle id; `hint` is the previous answer in the same
+  /// search set and becomes this one.
+  NearestHit project(const Vec3& p, const Vec3& area_normal, Index part, Index& hint, bool* same_side) const {
+    const TriangleBvh& search = part == kInvalidIndex ? all : part_bvh[part];
     auto source_triangle = [&](Index t) { return part == kInvalidIndex ? t : part_triangles[part][t]; };
-    const Vec3& p = target.positions[v];
-    const double len = vertex_normal[v].norm();
+    const double len = area_normal.norm();
     NearestHit hit;
     if (len > 0.0) {
-      const Vec3 n = vertex_normal[v] / len;
+      const Vec3 n = area_normal / len;
       hit = search.nearest_if(p, [&](Index t) { return normals[source_triangle(t)].dot(n) > cos_limit; }, hint,
-                              side_limit * side_limit);
+                              side_limit_sq);
     }
     *same_side = hit.primitive != kInvalidIndex;
     if (!*same_side) hit = search.nearest(p, hint);
@@ -126,92 +132,111 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
       hit.primitive = source_triangle(hit.primitive);
     }
     return hit;
-  };
+  }
+};
 
-  // keep_parts (skin.h): the source parts that hold at least min_part_share of a target part's
-  // closest points (by vertex area) are its candidates; it keeps to the candidate its vertices
-  // lie closest to (area-weighted mean squared distance: the ram's eyeball is overlapped by two
-  // eyelid shells, and half its vertices lie nearest to a lid), unless a vertex lies farther from
-  // that one than max_part_distance_edges mean edge lengths of the part (a part a reducer joined
-  // from two: no one input part lies under all of it). kInvalidIndex = every part.
+// keep_parts (skin.h): per target part, the source part it keeps to, or kInvalidIndex (every
+// part). The source parts that hold at least min_part_share of the part's closest points (by
+// vertex area) are its candidates; it keeps to the candidate its vertices lie closest to
+// (area-weighted mean squared distance: the ram's eyeball is overlapped by two eyelid shells, and
+// half its vertices lie nearest to a lid), unless a vertex lies farther from that one than
+// max_part_distance_edges mean edge lengths of the part (a part a reducer joined from two: no
+// one input part lies under all of it).
+std::vector<Index> match_parts(const SourceSurface& source, const PolyMesh& target, const std::vector<Index>& target_part,
+                               Index target_parts, const std::vector<Vec3>& vertex_normal,
+                               const SkinTransferParams& params) {
+  std::vector<Index> matched(target_parts, kInvalidIndex);
+  // Each target part's mean edge length (every face side counted once per face).
+  std::vector<double> part_edge(target_parts, 0.0), part_sides(target_parts, 0.0);
+  for (Index f = 0; f < target.num_faces(); ++f) {
+    const auto vs = target.face_vertices(f);
+    for (std::size_t i = 0; i < vs.size(); ++i) {
+      part_edge[target_part[vs[i]]] += (target.positions[vs[i]] - target.positions[vs[(i + 1) % vs.size()]]).norm();
+      part_sides[target_part[vs[i]]] += 1.0;
+    }
+  }
+  for (Index c = 0; c < target_parts; ++c) part_edge[c] = part_sides[c] > 0.0 ? part_edge[c] / part_sides[c] : 0.0;
+  std::vector<std::vector<std::pair<Index, double>>> votes(target_parts);  // (source part, area)
+  std::vector<std::vector<Index>> members(target_parts);
+  Index hint = kInvalidIndex;
+  bool same_side = false;
+  for (Index v = 0; v < target.num_vertices(); ++v) {
+    members[target_part[v]].push_back(v);
+    const NearestHit hit = source.project(target.positions[v], vertex_normal[v], kInvalidIndex, hint, &same_side);
+    if (hit.primitive != kInvalidIndex)
+      votes[target_part[v]].push_back({source.triangle_part[hit.primitive], vertex_normal[v].norm()});
+  }
+  for (Index c = 0; c < target_parts; ++c) {
+    auto& vc = votes[c];
+    std::sort(vc.begin(), vc.end());
+    double total = 0.0;
+    for (const auto& [part, area] : vc) total += area;
+    if (!(total > 0.0)) continue;
+    double best = INFINITY, best_far = 0.0;
+    for (std::size_t i = 0; i < vc.size();) {
+      double share = 0.0;
+      std::size_t j = i;
+      for (; j < vc.size() && vc[j].first == vc[i].first; ++j) share += vc[j].second;
+      if (share >= params.min_part_share * total) {
+        double sum = 0.0, far = 0.0;
+        Index h = kInvalidIndex;
+        for (Index v : members[c]) {
+          const NearestHit hit = source.project(target.positions[v], vertex_normal[v], vc[i].first, h, &same_side);
+          sum += vertex_normal[v].norm() * hit.distance_sq;
+          far = std::max(far, hit.distance_sq);
+        }
+        if (sum < best) {
+          best = sum;
+          best_far = far;
+          matched[c] = vc[i].first;
+        }
+      }
+      i = j;
+    }
+    const double reach = params.max_part_distance_edges * part_edge[c];
+    if (!(best_far <= reach * reach)) matched[c] = kInvalidIndex;
+  }
+  return matched;
+}
+
+}  // namespace
+
+SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
+                                         const SkinTransferParams& params) {
+  SkinTransferResult result;
+  SourceSurface surface(source, params);
+  const Index max_influences = params.max_influences > 0 ? params.max_influences : source.skin.max_influences();
+
+  // Area-weighted vertex normals of the target.
+  std::vector<Vec3> vertex_normal(target.num_vertices(), Vec3::Zero());
+  for (Index f = 0; f < target.num_faces(); ++f) {
+    const Vec3 area = face_area_vector(target, f);
+    for (Index v : target.face_vertices(f)) vertex_normal[v] += area;
+  }
+
   Index target_parts = 0;
   const std::vector<Index> target_part = vertex_parts(target, &target_parts);
   result.parts = target_parts;
   std::vector<Index> matched(target_parts, kInvalidIndex);
-  if (params.keep_parts && source_parts > 1 && !triangles.empty()) {
-    part_triangles.resize(source_parts);
-    for (Index t = 0; t < triangles.size(); ++t) part_triangles[triangle_part[t]].push_back(t);
-    part_bvh.resize(source_parts);
-    for (Index c = 0; c < source_parts; ++c) {
-      std::vector<std::array<Vec3, 3>> tris;
-      for (Index t : part_triangles[c]) tris.push_back(triangles[t]);
-      if (!tris.empty()) part_bvh[c] = TriangleBvh(tris);
-    }
-    // Each target part's mean edge length (every face side counted once per face).
-    std::vector<double> part_edge(target_parts, 0.0), part_sides(target_parts, 0.0);
-    for (Index f = 0; f < target.num_faces(); ++f) {
-      const auto vs = target.face_vertices(f);
-      for (std::size_t i = 0; i < vs.size(); ++i) {
-        part_edge[target_part[vs[i]]] += (target.positions[vs[i]] - target.positions[vs[(i + 1) % vs.size()]]).norm();
-        part_sides[target_part[vs[i]]] += 1.0;
-      }
-    }
-    for (Index c = 0; c < target_parts; ++c) part_edge[c] = part_sides[c] > 0.0 ? part_edge[c] / part_sides[c] : 0.0;
-    std::vector<std::vector<std::pair<Index, double>>> votes(target_parts);  // (source part, area)
-    std::vector<std::vector<Index>> members(target_parts);
-    Index hint = kInvalidIndex;
-    bool same_side = false;
-    for (Index v = 0; v < target.num_vertices(); ++v) {
-      members[target_part[v]].push_back(v);
-      const NearestHit hit = project(v, kInvalidIndex, hint, &same_side);
-      if (hit.primitive == kInvalidIndex) continue;
-      votes[target_part[v]].push_back({triangle_part[hit.primitive], vertex_normal[v].norm()});
-    }
-    for (Index c = 0; c < target_parts; ++c) {
-      auto& vc = votes[c];
-      std::sort(vc.begin(), vc.end());
-      double total = 0.0;
-      for (const auto& [part, area] : vc) total += area;
-      if (!(total > 0.0)) continue;
-      double best = INFINITY, best_far = 0.0;
-      for (std::size_t i = 0; i < vc.size();) {
-        double share = 0.0;
-        std::size_t j = i;
-        for (; j < vc.size() && vc[j].first == vc[i].first; ++j) share += vc[j].second;
-        if (share >= params.min_part_share * total) {
-          double sum = 0.0, far = 0.0;
-          Index h = kInvalidIndex;
-          for (Index v : members[c]) {
-            const NearestHit hit = project(v, vc[i].first, h, &same_side);
-            sum += vertex_normal[v].norm() * hit.distance_sq;
-            far = std::max(far, hit.distance_sq);
-          }
-          if (sum < best) {
-            best = sum;
-            best_far = far;
-            matched[c] = vc[i].first;
-          }
-        }
-        i = j;
-      }
-      const double reach = params.max_part_distance_edges * part_edge[c];
-      if (!(best_far <= reach * reach)) matched[c] = kInvalidIndex;
-      result.parts_matched += matched[c] != kInvalidIndex;
-    }
+  if (params.keep_parts && surface.parts > 1 && !surface.triangles.empty()) {
+    surface.build_part_bvhs();
+    matched = match_parts(surface, target, target_part, target_parts, vertex_normal, params);
+    for (Index m : matched) result.parts_matched += m != kInvalidIndex;
   }
 
   std::vector<std::vector<Influence>> per_vertex(target.num_vertices());
   double sum_distance = 0.0;
   Index hint = kInvalidIndex;
-  std::vector<Index> part_hint(part_bvh.size(), kInvalidIndex);
+  std::vector<Index> part_hint(surface.part_bvh.size(), kInvalidIndex);
   for (Index v = 0; v < target.num_vertices(); ++v) {
     const Index part = matched[target_part[v]];
     bool same_side = false;
-    const NearestHit hit = project(v, part, part == kInvalidIndex ? hint : part_hint[part], &same_side);
+    const NearestHit hit = surface.project(target.positions[v], vertex_normal[v], part,
+                                           part == kInvalidIndex ? hint : part_hint[part], &same_side);
     ++(same_side ? result.same_side : result.nearest_only);
     if (hit.primitive == kInvalidIndex) continue;  // empty source: no weights
-    const auto& c = corners[hit.primitive];
-    const auto& t = triangles[hit.primitive];
+    const auto& c = surface.corners[hit.primitive];
+    const auto& t = surface.triangles[hit.primitive];
     const Vec3 bary = barycentric(hit.point, t[0], t[1], t[2]);
     std::vector<Influence> blend;
     for (int k = 0; k < 3; ++k)
