@@ -67,6 +67,9 @@ struct SurfaceFitParams {
   /// edges, UV seams and material borders, whose lines eval holds to the input's: `seams_torn`,
   /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
   const std::vector<std::uint8_t>* fixed_vertices = nullptr;
+  /// An output with a face of more corners than this is not fitted (a large n-gon's fan
+  /// triangles are not its surface; the fit over a 50 000-corner fan took 75 s).
+  Index max_face_corners = 32;
   int threads = 0;
   /// Evaluate E once more after the last step (energy_after). The pipeline does not: it is a
   /// whole evaluation, a fifth of the fit's queries, for a figure of the report.
