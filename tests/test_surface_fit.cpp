@@ -243,5 +243,24 @@ TEST(SurfaceFit, InPosesOnlyVerticesOnOneBoneMove) {
   EXPECT_GT(moved, 0u);
 }
 
+TEST(SurfaceFit, AnOutputWithALargeNGonIsLeftAsItIs) {
+  // A 40-gon (above max_face_corners = 32) raised above a disc: not fitted, not a vertex moved.
+  PolyMesh input = make_grid(8, 8);
+  PolyMesh output;
+  std::vector<Index> ring;
+  for (int i = 0; i < 40; ++i) {
+    const double a = 2 * std::numbers::pi * i / 40;
+    ring.push_back(output.add_vertex(Vec3(0.5 + 0.4 * std::cos(a), 0.5 + 0.4 * std::sin(a), 0.05)));
+  }
+  output.add_face(ring);
+  const std::vector<Vec3> before = output.positions;
+  const SurfaceFitResult r = fit_to_surface(input, output);
+  EXPECT_EQ(r.steps, 0);
+  EXPECT_EQ(output.positions, before);
+  SurfaceFitParams loose;
+  loose.max_face_corners = 64;
+  EXPECT_GT(fit_to_surface(input, output, loose).moved_vertices, 0u);  // the same face, allowed
+}
+
 }  // namespace
 }  // namespace quadlod
