@@ -142,6 +142,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--surface-fit", p.surface_fit_iterations,
                   "Steps of the final fit of the output's vertices to the input surface (lower Chamfer; 0 = keep the collapse's placements)")
       ->check(CLI::Range(0, 100))->capture_default_str()->group("Features");
+  sub->add_option("--surface-fit-vertex-weight", p.surface_fit_vertex_weight,
+                  "Weight of peak vertices (farther from the input than their faces' samples) in the fit: lower Hausdorff, higher Chamfer (0.25 measured; 0 = off)")
+      ->check(CLI::Range(0.0, 100.0))->capture_default_str()->group("Features");
   sub->add_option("--hard-angle", p.hard_angle_deg, "Dihedral angle (degrees) from which an edge is a hard edge")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str()->group("Features");
   sub->add_flag("--no-consistency", opt->no_consistency, "Ablation: drop Eq. 4")->group("Ablations");

@@ -716,6 +716,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       pass_input == &current) {
     SurfaceFitParams fp;
     fp.iterations = options.surface_fit_iterations;
+    fp.vertex_weight = options.surface_fit_vertex_weight;
     fp.threads = options.threads;
     // Vertices on non-manifold edges, UV seams and material borders stay where the collapse put
     // them (eval holds seams to the input's: seams_torn). Boundary vertices move: the ram's eye
@@ -755,6 +756,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     const Stopwatch fit_clock;
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
+                             {"vertex_weight", fp.vertex_weight},
                              {"steps", fit.steps},
                              {"energy_before", fit.energy_before},
                              {"energy_last_step", fit.energy_last_step},
@@ -869,6 +871,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"hard_angle_deg", options.hard_angle_deg},
       {"place_on_hard_edges", options.place_on_hard_edges},
       {"surface_fit_iterations", options.surface_fit_iterations},
+      {"surface_fit_vertex_weight", options.surface_fit_vertex_weight},
       {"skin_poses", input.skin.empty() ? 0 : options.skin_poses.size()},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
