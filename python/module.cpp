@@ -68,6 +68,9 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"features", set_field(&SimplifyOptions::features)},
       {"place_on_hard_edges", set_field(&SimplifyOptions::place_on_hard_edges)},
       {"hard_angle", set_field(&SimplifyOptions::hard_angle_deg)},
+      {"surface_fit", set_field(&SimplifyOptions::surface_fit_iterations)},
+      {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
+      {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},
       {"consistency", set_field(&SimplifyOptions::consistency)},
       {"segmentation", set_field(&SimplifyOptions::segmentation)},
       {"geometry", set_field(&SimplifyOptions::geometry)},
@@ -92,6 +95,8 @@ void check_ranges(const SimplifyOptions& o) {
   in(o.hard_angle_deg, 0.0, 180.0, "hard_angle");
   in(o.max_hausdorff, 0.0, 1.0, "max_hausdorff");
   in(o.max_rounds, 1, 64, "max_rounds");
+  in(o.surface_fit_iterations, 0, 100, "surface_fit");
+  in(o.surface_fit_vertex_weight, 0.0, 100.0, "surface_fit_vertex_weight");
   if (o.objective != "shape" && o.objective != "paper")
     throw py::value_error("objective: 'shape' or 'paper', not '" + o.objective + "'");
   if (o.strategy != "auto" && o.strategy != "whole" && o.strategy != "neighbourhoods")
@@ -266,7 +271,8 @@ corner count of each face, as Blender and trimesh hold polygons — or an (F, k)
 ratio: target as a fraction of the input's triangle-equivalents (quad = 2, k-gon = k - 2), or
 faces_target: that count. uvs: per-corner (C, 2) or {name: (C, 2)}; normals: per-corner (C, 3);
 materials: per-face slot index (F,). Further keywords are the CLI's options with '_' for '-'
-(objective, effort, time_limit, time_bound, threads, seed, features, hard_angle, max_hausdorff, pass_ratio, ...).
+(objective, effort, time_limit, time_bound, threads, seed, features, hard_angle, max_hausdorff, pass_ratio,
+surface_fit, surface_fit_vertex_weight, ...).
 Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials] of the reduced mesh and
 report (the JSON report of `simplify --report`, plus target/achieved/quads/triangles/ngons).
 Raises QuadlodError with the CLI's message on bad input.)");

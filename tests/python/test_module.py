@@ -187,6 +187,29 @@ def test_errors_are_exceptions_with_the_library_message():
     assert issubclass(quadlod.QuadlodError, ValueError)
 
 
+def test_surface_fit_options_reach_the_fit():
+    """The CLI's --surface-fit and --surface-fit-vertex-weight, with its ranges."""
+    vertices, quads, _, _ = torus()
+    default = quadlod.simplify(vertices, quads, ratio=0.4)
+    assert default["report"]["surface_fit"]["iterations"] == 2  # on by default (simplify.h)
+    assert default["report"]["surface_fit"]["vertex_weight"] == 0.0
+    off = quadlod.simplify(vertices, quads, ratio=0.4, surface_fit=0)
+    assert "surface_fit" not in off["report"]
+    np.testing.assert_array_equal(off["faces"], default["faces"])  # the fit moves vertices only
+    assert not np.array_equal(off["vertices"], default["vertices"])
+    peak = quadlod.simplify(vertices, quads, ratio=0.4, surface_fit_vertex_weight=0.25)
+    assert peak["report"]["surface_fit"]["vertex_weight"] == 0.25
+    with pytest.raises(ValueError, match=r"surface_fit: 101"):
+        quadlod.simplify(vertices, quads, ratio=0.4, surface_fit=101)
+    with pytest.raises(ValueError, match="surface_fit_vertex_weight"):
+        quadlod.simplify(vertices, quads, ratio=0.4, surface_fit_vertex_weight=-1.0)
+    # --decide-on-doubles: the torus's float64 coordinates are not float32 values, so by default
+    # the decisions are made on them rounded, and the report says so; with the option, on them as given.
+    doubles = quadlod.simplify(vertices, quads, ratio=0.4, decide_on_doubles=True)
+    assert default["report"]["float32_decisions"] is True
+    assert "float32_decisions" not in doubles["report"]
+
+
 def test_the_input_arrays_are_not_modified():
     vertices, quads, uvs, materials = torus()
     copies = [a.copy() for a in (vertices, quads, uvs, materials)]
