@@ -69,6 +69,7 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"place_on_hard_edges", set_field(&SimplifyOptions::place_on_hard_edges)},
       {"hard_angle", set_field(&SimplifyOptions::hard_angle_deg)},
       {"surface_fit", set_field(&SimplifyOptions::surface_fit_iterations)},
+      {"recover_quads", set_field(&SimplifyOptions::recover_quads)},
       {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
       {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},
       {"consistency", set_field(&SimplifyOptions::consistency)},
@@ -99,6 +100,8 @@ void check_ranges(const SimplifyOptions& o) {
   in(o.surface_fit_vertex_weight, 0.0, 100.0, "surface_fit_vertex_weight");
   if (o.objective != "shape" && o.objective != "paper")
     throw py::value_error("objective: 'shape' or 'paper', not '" + o.objective + "'");
+  if (o.recover_quads != "auto" && o.recover_quads != "on" && o.recover_quads != "off")
+    throw py::value_error("recover_quads: 'auto', 'on' or 'off', not '" + o.recover_quads + "'");
   if (o.strategy != "auto" && o.strategy != "whole" && o.strategy != "neighbourhoods")
     throw py::value_error("strategy: 'auto', 'whole' or 'neighbourhoods', not '" + o.strategy + "'");
 }

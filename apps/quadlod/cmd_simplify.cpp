@@ -142,6 +142,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--surface-fit", p.surface_fit_iterations,
                   "Steps of the final fit of the output's vertices to the input surface (lower Chamfer; 0 = keep the collapse's placements)")
       ->check(CLI::Range(0, 100))->capture_default_str()->group("Features");
+  sub->add_option("--recover-quads", p.recover_quads,
+                  "Join triangle pairs back into quads before the reduction: auto (when every face is a triangle, as in glTF), on, off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str()->group("Features");
   sub->add_option("--surface-fit-vertex-weight", p.surface_fit_vertex_weight,
                   "Weight of peak vertices (farther from the input than their faces' samples) in the fit: lower Hausdorff, higher Chamfer (0.25 measured; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->capture_default_str()->group("Features");

@@ -41,6 +41,12 @@ struct SimplifyOptions {
   /// greedy (src/select/shape_selection.h). "paper": Eq. 9 with the MIP / annealing search
   /// below (the paper's objective, for the ablation table).
   std::string objective = "shape";
+  /// Quads joined again from triangle pairs before the reduction (src/mesh/quad_recovery.h;
+  /// docs/scenes.md, "Triangulated inputs"): "auto" (default) when every face of the input is a
+  /// triangle, as glTF and most exporters write them; "on" also for meshes with polygons (their
+  /// triangles are joined where they pair up); "off" never. Blender's thresholds (40°, 40°); on
+  /// six fan-triangulated quad meshes 93–99 % of the quads it makes were input quads.
+  std::string recover_quads = "auto";
   double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
   double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = by ratio (below), 0 = none
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default

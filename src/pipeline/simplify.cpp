@@ -3,6 +3,7 @@
 #include "quadlod/simplify.h"
 
 #include "mesh/connectivity.h"
+#include "mesh/quad_recovery.h"
 #include "mesh/features.h"
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
@@ -872,6 +873,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"place_on_hard_edges", options.place_on_hard_edges},
       {"surface_fit_iterations", options.surface_fit_iterations},
       {"surface_fit_vertex_weight", options.surface_fit_vertex_weight},
+      {"recover_quads", options.recover_quads},
       {"skin_poses", input.skin.empty() ? 0 : options.skin_poses.size()},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},
@@ -945,13 +947,55 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
 // Decisions on float32 positions, UVs and normals, so that a mesh reduces the same from an OBJ as
 // from its FBX or glTF (src/pipeline/storage_precision.h); what did not move keeps the input's own
 // values.
+namespace {
+
+std::string check_recover_quads(const SimplifyOptions& options) {
+  if (options.recover_quads == "auto" || options.recover_quads == "on" || options.recover_quads == "off") return {};
+  return "unknown recover_quads '" + options.recover_quads + "' (auto, on, off)";
+}
+
+// SimplifyOptions::recover_quads: whether this input's triangle pairs are joined first.
+bool joins_triangles(const PolyMesh& input, const SimplifyOptions& options) {
+  return options.recover_quads == "on" || (options.recover_quads == "auto" && all_triangles(input));
+}
+
+// The reduction of the input with its triangle pairs joined (the same vertices, so every
+// per-vertex and per-corner attribute, weight and the float32 rule apply as they are); the report
+// says how many quads were made.
+SimplifyResult simplify_recovered(const PolyMesh& input, const SimplifyOptions& options) {
+  QuadRecoveryResult recovered = recover_quads(input);
+  SimplifyOptions rest = options;
+  rest.recover_quads = "off";
+  SimplifyResult result = simplify_in_place(recovered.mesh, rest);
+  result.report["quad_recovery"] = {{"input_faces", input.num_faces()},
+                                    {"candidates", recovered.candidates},
+                                    {"quads_made", recovered.joined},
+                                    {"faces_after", recovered.mesh.num_faces()}};
+  result.report["options"]["recover_quads"] = options.recover_quads;
+  return result;
+}
+
+}  // namespace
+
 SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+  if (const std::string bad = check_recover_quads(options); !bad.empty()) {
+    SimplifyResult r;
+    r.error = bad;
+    return r;
+  }
+  if (joins_triangles(input, options)) return simplify_recovered(input, options);
   if (!options.float32_decisions || !float32_rounding_changes(input)) return simplify_on(input, options);
   PolyMesh own = input;  // rounded in place below, its exact values put back
   return simplify_in_place(own, options);
 }
 
 SimplifyResult simplify_in_place(PolyMesh& input, const SimplifyOptions& options) {
+  if (const std::string bad = check_recover_quads(options); !bad.empty()) {
+    SimplifyResult r;
+    r.error = bad;
+    return r;
+  }
+  if (joins_triangles(input, options)) return simplify_recovered(input, options);
   if (!options.float32_decisions) return simplify_on(input, options);
   std::optional<PolyMesh> exact = round_to_float32_in_place(input);
   if (!exact) return simplify_on(input, options);

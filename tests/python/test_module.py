@@ -210,6 +210,20 @@ def test_surface_fit_options_reach_the_fit():
     assert "float32_decisions" not in doubles["report"]
 
 
+def test_an_all_triangle_input_gets_its_quads_back():
+    """recover_quads (the CLI's --recover-quads): auto joins the triangle pairs of a triangulated mesh."""
+    vertices, quads, _, _ = torus()
+    tris = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    r = quadlod.simplify(vertices, tris, ratio=0.5)
+    assert r["report"]["quad_recovery"]["quads_made"] == len(quads)
+    assert np.mean(r["face_sizes"] == 4) >= 0.9
+    off = quadlod.simplify(vertices, tris, ratio=0.5, recover_quads="off")
+    assert "quad_recovery" not in off["report"]
+    assert np.all(off["face_sizes"] == 3)
+    with pytest.raises(ValueError, match="recover_quads: 'auto', 'on' or 'off', not 'yes'"):
+        quadlod.simplify(vertices, tris, ratio=0.5, recover_quads="yes")
+
+
 def test_the_input_arrays_are_not_modified():
     vertices, quads, uvs, materials = torus()
     copies = [a.copy() for a in (vertices, quads, uvs, materials)]
