@@ -144,3 +144,28 @@ TEST_F(CliTest, GenerateWritesEveryFormat) {
     EXPECT_EQ(j["boundary_edges"], 0);
   }
 }
+
+TEST_F(CliTest, AnAllTriangleInputIsJoinedIntoQuadsAndTheSummarySaysSo) {
+  // A 3 × 2 grid written as triangles (each quad split along a diagonal, as a glTF exporter does).
+  const fs::path mesh = dir / "tris.obj", out = dir / "out.obj", kept = dir / "kept.obj";
+  std::string text;
+  for (int y = 0; y <= 2; ++y)
+    for (int x = 0; x <= 3; ++x) text += "v " + std::to_string(x) + " " + std::to_string(y) + " 0\n";
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) {
+      const int a = y * 4 + x + 1, b = a + 1, c = a + 5, d = a + 4;
+      text += "f " + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(c) + "\n";
+      text += "f " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(d) + "\n";
+    }
+  write_text(mesh, text);
+  CliRun run = run_cli("simplify " + mesh.string() + " -o " + out.string() + " --ratio 1", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("quads: the input is all triangles; 6 pairs were joined into quads first"), std::string::npos) << run.out;
+  run = run_cli("simplify " + mesh.string() + " -o " + kept.string() + " --ratio 1 --recover-quads off", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out.find("quads:"), std::string::npos) << run.out;
+  EXPECT_EQ(run_cli("simplify " + mesh.string() + " -o " + kept.string() + " --recover-quads maybe", dir).exit_code, 1);
+  const auto info = nlohmann::json::parse(run_cli("info --json " + out.string(), dir).out);
+  EXPECT_EQ(info["quads"], 6);
+  EXPECT_EQ(info["triangles"], 0);
+}

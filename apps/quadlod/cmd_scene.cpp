@@ -57,6 +57,12 @@ int simplify_scene_file(const std::string& input, const std::string& output, con
               r.scene.meshes.size(), r.scene.meshes.size() == 1 ? "" : "es",
               static_cast<unsigned long long>(r.target), static_cast<unsigned long long>(r.achieved), r.quads,
               r.triangles, r.ngons, read_seconds, reduce_seconds, write_seconds);
+  std::uint64_t joined = 0;
+  for (const auto& m : r.report["meshes"])
+    if (m.contains("simplify") && m["simplify"].contains("quad_recovery")) joined += m["simplify"]["quad_recovery"]["quads_made"].get<std::uint64_t>();
+  if (joined > 0)
+    std::printf("quads: all-triangle meshes had %llu pairs joined into quads first (--recover-quads off keeps them)\n",
+                static_cast<unsigned long long>(joined));
   if (format == SceneFormat::Glb) std::printf("note: glTF holds triangles only: %s has its polygons triangulated\n", output.c_str());
   return kExitOk;
 }

@@ -320,6 +320,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                 rep["stage_seconds"]["dual"].get<double>(), rep["stage_seconds"]["collapse"].get<double>(),
                 r.passes_used, r.passes_used == 1 ? "" : "es", rep["rounds"].size(),
                 rep["stage_seconds"].value("fit", 0.0), read_seconds + rep["seconds"].get<double>() + write_seconds);
+            if (rep.contains("quad_recovery"))
+              std::printf("quads: the input is all triangles; %llu pairs were joined into quads first (--recover-quads off keeps them)\n",
+                          static_cast<unsigned long long>(rep["quad_recovery"]["quads_made"].get<std::uint64_t>()));
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;
           }};
