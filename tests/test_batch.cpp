@@ -133,3 +133,40 @@ TEST_F(Batch, ManifestWithPerAssetOptionsAndLodChains) {
   ASSERT_FALSE(malformed.ok());
   EXPECT_NE(malformed.error.find("bad.jsonl:2"), std::string::npos) << malformed.error;
 }
+
+TEST_F(Batch, RecoverQuadsReachesEachJobAndIsChecked) {
+  // A torus written as triangles (each quad split along a diagonal).
+  const PolyMesh torus = make_torus(16, 8);
+  PolyMesh tris;
+  tris.positions = torus.positions;
+  for (Index f = 0; f < torus.num_faces(); ++f) {
+    const auto v = torus.face_vertices(f);
+    tris.add_face({v[0], v[1], v[2]});
+    tris.add_face({v[0], v[2], v[3]});
+  }
+  fs::create_directories(dir / "assets");
+  ASSERT_TRUE(write_mesh(tris, dir / "assets" / "tris.obj").ok());
+  write_text(dir / "jobs.jsonl",
+             "{\"input\": \"assets/tris.obj\", \"output\": \"out/auto.obj\", \"ratio\": 0.5}\n"
+             "{\"input\": \"assets/tris.obj\", \"output\": \"out/off.obj\", \"ratio\": 0.5, \"recover_quads\": \"off\"}\n"
+             "{\"input\": \"assets/tris.obj\", \"output\": \"out/bad.obj\", \"ratio\": 0.5, \"recover_quads\": \"maybe\"}\n");
+  const CliRun run = run_cli("-q batch '" + (dir / "jobs.jsonl").string() + "'", dir);
+  EXPECT_EQ(run.exit_code, 2);  // the bad value
+  const auto parsed = lines(run.out);
+  ASSERT_EQ(parsed.size(), 3u);
+  EXPECT_EQ(parsed[0]["status"], "done") << parsed[0].dump();
+  EXPECT_EQ(parsed[1]["status"], "done") << parsed[1].dump();
+  EXPECT_EQ(parsed[2]["status"], "failed");
+  EXPECT_NE(parsed[2]["error"].get<std::string>().find("recover_quads must be auto, on or off"), std::string::npos)
+      << parsed[2].dump();
+  auto quads = [](const fs::path& p) {
+    const ReadResult r = read_mesh(p);
+    Index n = 0;
+    for (Index f = 0; f < r.mesh.num_faces(); ++f) n += r.mesh.face_size(f) == 4;
+    return n;
+  };
+  EXPECT_GT(quads(dir / "out" / "auto.obj"), 0);
+  EXPECT_EQ(quads(dir / "out" / "off.obj"), 0);
+  // The folder mode's --recover-quads is checked by the command line.
+  EXPECT_EQ(run_cli("-q batch assets -o out2 --ratio 0.5 --recover-quads maybe", dir).exit_code, 1);
+}

@@ -168,4 +168,11 @@ TEST_F(CliTest, AnAllTriangleInputIsJoinedIntoQuadsAndTheSummarySaysSo) {
   const auto info = nlohmann::json::parse(run_cli("info --json " + out.string(), dir).out);
   EXPECT_EQ(info["quads"], 6);
   EXPECT_EQ(info["triangles"], 0);
+  // The LOD chain's first level is reduced from the joined mesh too, unless told not to.
+  ASSERT_EQ(run_cli("-q lod " + mesh.string() + " -o " + (dir / "lods").string() + " --levels 0.5 --format obj", dir).exit_code, 0);
+  ASSERT_EQ(run_cli("-q lod " + mesh.string() + " -o " + (dir / "lods_off").string() + " --levels 0.5 --format obj --recover-quads off", dir).exit_code, 0);
+  const auto lods = nlohmann::json::parse(slurp(dir / "lods" / "lods.json"));
+  const auto lods_off = nlohmann::json::parse(slurp(dir / "lods_off" / "lods.json"));
+  EXPECT_GT(lods["levels"][0]["quads"].get<int>(), 0) << lods.dump();
+  EXPECT_EQ(lods_off["levels"][0]["quads"].get<int>(), 0) << lods_off.dump();
 }

@@ -19,6 +19,7 @@ struct BatchCliOptions {
   int count = 0;
   bool per_mesh = false, force = false, no_features = false;
   std::string objective;
+  std::string recover_quads;
   int threads = -1;
 };
 
@@ -42,6 +43,8 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"glb", "obj", "fbx", "dae", "ply", "off"}));
   sub->add_flag("--per-mesh", opt->per_mesh, "Scenes: the target applies to each mesh");
   sub->add_option("--objective", opt->objective, "shape or paper")->check(CLI::IsMember({"shape", "paper"}));
+  sub->add_option("--recover-quads", opt->recover_quads, "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
   sub->add_option("--shard", opt->shard,
@@ -62,6 +65,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (count->count()) defaults["count"] = opt->count;
             if (opt->per_mesh) defaults["per_mesh"] = true;
             if (!opt->objective.empty()) defaults["objective"] = opt->objective;
+            if (!opt->recover_quads.empty()) defaults["recover_quads"] = opt->recover_quads;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
             const bool folder = std::filesystem::is_directory(opt->source);

@@ -18,7 +18,8 @@ namespace quadlod {
 ///                                     directory (files <stem>.lodI.<format> + lods.json);
 ///   "format": "glb" | "fbx" | …      → lod: file format (default: the input's, else glb);
 ///   "per_mesh": bool, "objective": "shape" | "paper", "time_limit": s, "threads": n,
-///   "seed": n, "features": bool      → as the CLI's options of the same names.
+///   "seed": n, "features": bool,
+///   "recover_quads": "auto" | "on" | "off" → as the CLI's options of the same names.
 /// Unknown keys are an error of that job (a typo must not silently change the run).
 struct BatchJob {
   std::filesystem::path input;

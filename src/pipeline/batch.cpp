@@ -19,7 +19,8 @@ bool is_lod(const nlohmann::json& options) { return options.contains("levels") |
 std::string apply_options(const nlohmann::json& options, SimplifyOptions& simplify, bool& per_mesh,
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
-                                               "objective", "time_limit", "threads", "seed", "features"};
+                                               "objective", "time_limit", "threads", "seed", "features",
+                                               "recover_quads"};
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -32,6 +33,7 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
     if (options.contains("threads")) simplify.threads = options["threads"].get<int>();
     if (options.contains("seed")) simplify.seed = options["seed"].get<std::uint32_t>();
     if (options.contains("features")) simplify.features = options["features"].get<bool>();
+    if (options.contains("recover_quads")) simplify.recover_quads = options["recover_quads"].get<std::string>();
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
     if (options.contains("format")) format = options["format"].get<std::string>();
@@ -40,6 +42,8 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
   }
   if (!(simplify.ratio > 0.0 && simplify.ratio <= 1.0)) return "ratio must be in (0, 1]";
   if (simplify.objective != "shape" && simplify.objective != "paper") return "objective must be shape or paper";
+  if (simplify.recover_quads != "auto" && simplify.recover_quads != "on" && simplify.recover_quads != "off")
+    return "recover_quads must be auto, on or off";
   if (!is_lod(options) && !options.contains("ratio") && !options.contains("faces"))
     return "no target: give ratio, faces, levels or count";
   if (!format.empty() && format[0] != '.') format = "." + format;
