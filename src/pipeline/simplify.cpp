@@ -944,9 +944,6 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
   return std::move(kept);
 }
 
-// Decisions on float32 positions, UVs and normals, so that a mesh reduces the same from an OBJ as
-// from its FBX or glTF (src/pipeline/storage_precision.h); what did not move keeps the input's own
-// values.
 namespace {
 
 std::string check_recover_quads(const SimplifyOptions& options) {
@@ -975,27 +972,31 @@ SimplifyResult simplify_recovered(const PolyMesh& input, const SimplifyOptions& 
   return result;
 }
 
-}  // namespace
-
-SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
-  if (const std::string bad = check_recover_quads(options); !bad.empty()) {
+// What both entry points do first: refuse a bad recover_quads, or reduce the joined input.
+std::optional<SimplifyResult> refused_or_recovered(const PolyMesh& input, const SimplifyOptions& options) {
+  if (std::string bad = check_recover_quads(options); !bad.empty()) {
     SimplifyResult r;
-    r.error = bad;
+    r.error = std::move(bad);
     return r;
   }
   if (joins_triangles(input, options)) return simplify_recovered(input, options);
+  return std::nullopt;
+}
+
+}  // namespace
+
+// Decisions on float32 positions, UVs and normals, so that a mesh reduces the same from an OBJ as
+// from its FBX or glTF (src/pipeline/storage_precision.h); what did not move keeps the input's own
+// values.
+SimplifyResult simplify(const PolyMesh& input, const SimplifyOptions& options) {
+  if (std::optional<SimplifyResult> r = refused_or_recovered(input, options)) return std::move(*r);
   if (!options.float32_decisions || !float32_rounding_changes(input)) return simplify_on(input, options);
   PolyMesh own = input;  // rounded in place below, its exact values put back
   return simplify_in_place(own, options);
 }
 
 SimplifyResult simplify_in_place(PolyMesh& input, const SimplifyOptions& options) {
-  if (const std::string bad = check_recover_quads(options); !bad.empty()) {
-    SimplifyResult r;
-    r.error = bad;
-    return r;
-  }
-  if (joins_triangles(input, options)) return simplify_recovered(input, options);
+  if (std::optional<SimplifyResult> r = refused_or_recovered(input, options)) return std::move(*r);
   if (!options.float32_decisions) return simplify_on(input, options);
   std::optional<PolyMesh> exact = round_to_float32_in_place(input);
   if (!exact) return simplify_on(input, options);
