@@ -70,6 +70,13 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"hard_angle", set_field(&SimplifyOptions::hard_angle_deg)},
       {"surface_fit", set_field(&SimplifyOptions::surface_fit_iterations)},
       {"recover_quads", set_field(&SimplifyOptions::recover_quads)},
+      {"seams",
+       [](SimplifyOptions& o, const py::handle& v) {
+         const std::string name = v.cast<std::string>();
+         const auto policy = parse_seam_policy(name);
+         if (!policy) throw py::value_error("seams: 'auto' or 'strict', not '" + name + "'");
+         o.seams = *policy;
+       }},
       {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
       {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},
       {"consistency", set_field(&SimplifyOptions::consistency)},

@@ -24,6 +24,50 @@ void expect_one_line_error(const CliRun& run, const std::string& must_contain) {
 
 class CliTest : public ScratchDirTest {};
 
+
+// Issue 32: --seams reaches simplify, lod and batch. Lone triangles (every edge a boundary) can
+// only meet a budget by letting small parts vanish: auto does once a pass stalls, strict never,
+// and strict's note says so.
+TEST_F(CliTest, SeamsStrictKeepsEveryPartAndSaysWhyItStopped) {
+  const fs::path mesh = dir / "lone.obj";
+  std::string text;
+  for (int k = 0; k < 50; ++k) {
+    const int x = 2 * (k % 10), y = 2 * (k / 10);
+    text += "v " + std::to_string(x) + " " + std::to_string(y) + " 0\n";
+    text += "v " + std::to_string(x + 1) + " " + std::to_string(y) + " 0\n";
+    text += "v " + std::to_string(x + 1) + " " + std::to_string(y + 1) + " 0\n";
+    text += "f " + std::to_string(3 * k + 1) + " " + std::to_string(3 * k + 2) + " " + std::to_string(3 * k + 3) + "\n";
+  }
+  write_text(mesh, text);
+  CliRun run = run_cli("-q simplify " + mesh.string() + " -o " + (dir / "auto.obj").string() + " --ratio 0.4 --report " +
+                           (dir / "auto.json").string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto a = nlohmann::json::parse(slurp(dir / "auto.json"));
+  EXPECT_EQ(a["seams"]["policy"], "auto");
+  EXPECT_EQ(a["achieved"], 20);
+  run = run_cli("-q simplify " + mesh.string() + " -o " + (dir / "strict.obj").string() +
+                    " --ratio 0.4 --seams strict --report " + (dir / "strict.json").string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto s = nlohmann::json::parse(slurp(dir / "strict.json"));
+  EXPECT_EQ(s["seams"]["policy"], "strict");
+  EXPECT_EQ(s["options"]["seams"], "strict");
+  EXPECT_EQ(s["achieved"], 50);
+  EXPECT_NE(run.out.find("+150.0 %"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("with --seams strict no line merges through an island and no part vanishes"), std::string::npos)
+      << run.out;
+  EXPECT_EQ(run_cli("simplify " + mesh.string() + " -o " + (dir / "x.obj").string() + " --seams sometimes", dir).exit_code, 1);
+  ASSERT_EQ(run_cli("-q lod " + mesh.string() + " -o " + (dir / "lods").string() + " --levels 0.4 --format obj --seams strict", dir).exit_code, 0);
+  const auto lods = nlohmann::json::parse(slurp(dir / "lods" / "lods.json"));
+  EXPECT_EQ(lods["levels"][0]["achieved"], 50) << lods.dump();
+  write_text(dir / "jobs.jsonl",
+             "{\"input\": \"lone.obj\", \"output\": \"out/strict.obj\", \"ratio\": 0.4, \"seams\": \"strict\"}\n"
+             "{\"input\": \"lone.obj\", \"output\": \"out/bad.obj\", \"ratio\": 0.4, \"seams\": \"loose\"}\n");
+  run = run_cli("-q batch '" + (dir / "jobs.jsonl").string() + "'", dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.out.find("seams must be auto or strict"), std::string::npos) << run.out;
+  EXPECT_EQ(nlohmann::json::parse(run_cli("info --json " + (dir / "out" / "strict.obj").string(), dir).out)["faces"], 50);
+}
+
 }  // namespace
 
 TEST_F(CliTest, UsageErrorsExitWithOne) {

@@ -1,6 +1,7 @@
 // quadlod::simplify end to end (paper Fig. 2): generated meshes with known answers and corpus
 // meshes against the output guarantees (issue: post-processing and `quadlod simplify`).
 #include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "mesh/validation.h"
 #include "quadlod/generators.h"
 #include "quadlod/io.h"
@@ -117,18 +118,27 @@ TEST(Simplify, NothingToDoAtFullSize) {
   EXPECT_EQ(r.mesh.num_faces(), torus.num_faces());
 }
 
-// Lone quads: every edge is a boundary, so no chord can go. The first pass finds nothing to
-// select; the run ends there rather than repeating the same nothing in every planned pass.
-TEST(Simplify, AMeshWithNothingToRemoveEndsAfterOnePass) {
+// n separate unit right triangles on a 20-wide lattice: every edge is a boundary.
+PolyMesh lone_triangles(int n) {
   PolyMesh lone;
-  for (int k = 0; k < 200; ++k) {
+  for (int k = 0; k < n; ++k) {
     const double x = 2.0 * (k % 20), y = 2.0 * (k / 20);
     const Index a = lone.add_vertex({x, y, 0}), b = lone.add_vertex({x + 1, y, 0}),
-                c = lone.add_vertex({x + 1, y + 1, 0}), d = lone.add_vertex({x, y + 1, 0});
-    lone.add_face({a, b, c, d});
+                c = lone.add_vertex({x + 1, y + 1, 0});
+    lone.add_face({a, b, c});
   }
+  return lone;
+}
+
+// Lone triangles: every edge is a boundary, and collapsing any of them would take a whole part
+// away. With --seams strict no part vanishes: the first pass finds nothing it may remove, and the
+// run ends there rather than repeating the same nothing in every planned pass; the note says how
+// far from the target it stopped.
+TEST(Simplify, AMeshWithNothingToRemoveEndsAfterOnePass) {
+  const PolyMesh lone = lone_triangles(200);
   SimplifyOptions o;
   o.ratio = 0.2;  // several passes planned
+  o.seams = SimplifyOptions::SeamPolicy::Strict;
   const SimplifyResult r = simplify(lone, o);
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_GT(r.report["passes_planned"].get<int>(), 1);
@@ -136,6 +146,23 @@ TEST(Simplify, AMeshWithNothingToRemoveEndsAfterOnePass) {
   EXPECT_EQ(r.achieved, r.input_tri_equivalent);
   EXPECT_EQ(r.mesh.num_faces(), lone.num_faces());
   EXPECT_NE(r.note.find("after 1 pass:"), std::string::npos) << r.note;
+}
+
+// The same lone triangles with --seams auto (the default): the first pass stalls, so parts below
+// the crossing bound may vanish (issue 32), and the run reaches the target; the report says which
+// bound each pass ran with.
+TEST(Simplify, AStalledPassLetsSmallPartsVanish) {
+  const PolyMesh lone = lone_triangles(200);
+  SimplifyOptions o;
+  o.ratio = 0.2;
+  const SimplifyResult r = simplify(lone, o);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_NEAR(double(r.achieved), 40.0, 0.03 * 40.0) << r.note;
+  const auto& passes = r.report["passes"];
+  EXPECT_EQ(passes[0]["vanishing_part_area"].get<double>(), 0.0);
+  EXPECT_GT(passes.back()["vanishing_part_area"].get<double>(), 0.5);  // a triangle's area
+  // Whatever survives is a whole input triangle.
+  for (Index f = 0; f < r.mesh.num_faces(); ++f) EXPECT_EQ(r.mesh.face_size(f), 3u);
 }
 
 // A mesh and its float32-rounded copy (what FBX and glTF store) reduce to the same faces, and
@@ -382,11 +409,34 @@ TEST(SimplifyCorpus, IslandsAreNotCutAtSidesWithMoreThanTwoFaces) {
   ASSERT_TRUE(r.ok()) << r.error;
   const auto& islands = r.report["uv_islands"];
   EXPECT_EQ(islands["in"], 12347);
-  EXPECT_EQ(islands["split"], 0) << islands["split_islands"];
-  EXPECT_EQ(islands["merged"], 0);
   EXPECT_EQ(islands["appeared"], 0);
   EXPECT_EQ(islands["vanished"], islands["vanished_below_one_face"]);
-  EXPECT_EQ(islands["out"], std::int64_t(islands["in"]) - std::int64_t(islands["vanished"]));
+  EXPECT_EQ(std::int64_t(islands["out"]), std::int64_t(islands["in"]) - std::int64_t(islands["vanished"]) +
+                                              std::int64_t(islands["split_extra"]) -
+                                              std::int64_t(islands["merged_reduction"]));
+  // No island worth an output face is split. Since issue 32 a line shortens through its
+  // junctions, and one island smaller than that (7635: an octagonal cap and its 8-quad rim,
+  // 0.045 of the 0.176 an output face has, whose UVs differ across most of the rim) falls apart
+  // by its UVs in pass 3 of 5: each pass checks the islands of its own input, and the accounting
+  // those of the original.
+  const Connectivity conn = build_connectivity(in.mesh);
+  const UvIslands input_islands = find_uv_islands(in.mesh, conn, 0);
+  double area = 0.0;
+  for (double a : input_islands.area_3d) area += a;
+  const double one_face = area / double(r.target);
+  for (const auto& s : islands["split_islands"])
+    EXPECT_LT(input_islands.area_3d[s["input_island"].get<Index>()], one_face) << s;
+  EXPECT_LE(islands["split"].get<int>(), 1) << islands["split_islands"];
+  // Merged: only pairs of one-face islands that share no vertex in the input (7526 + 7527, ...),
+  // which the reduction brought edge to edge with equal UVs along the new edge (find_uv_islands
+  // joins only there), so their texture is continuous across it.
+  std::vector<Index> faces_of(input_islands.num_islands, 0);
+  for (Index f = 0; f < in.mesh.num_faces(); ++f)
+    if (input_islands.face_island[f] != kInvalidIndex) ++faces_of[input_islands.face_island[f]];
+  for (const auto& m : islands["merged_islands"]) {
+    EXPECT_EQ(m["input_islands"].size(), 2u) << m;
+    for (const auto& i : m["input_islands"]) EXPECT_EQ(faces_of[i.get<Index>()], 1u) << m;
+  }
 }
 
 // blender_suzanne at 0.2: the optimised selections meet more `flip` / `folded_corner` refusals
@@ -421,7 +471,7 @@ TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
   const SimplifyResult g = simplify(in.mesh, greedy);
   ASSERT_TRUE(g.ok()) << g.error;
   ASSERT_EQ(g.target, 194u);
-  EXPECT_EQ(g.achieved, 195u);
+  EXPECT_EQ(g.achieved, 194u);  // 195 before issue 32 let lines shorten through junctions
   EXPECT_FALSE(g.report.contains("fallback"));  // a greedy run has nothing to fall back to
 
   const SimplifyResult r = simplify(in.mesh, quick(0.2));
@@ -430,14 +480,15 @@ TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
   expect_valid(in.mesh, r.mesh, "suzanne 0.2");
   if (r.report.contains("fallback")) {
     const auto& f = r.report["fallback"];
-    EXPECT_EQ(f["greedy_achieved"], 195);
+    EXPECT_EQ(f["greedy_achieved"], 194);
     EXPECT_EQ(f["kept"], "greedy");
-    EXPECT_EQ(r.achieved, 195u);
+    EXPECT_EQ(r.achieved, 194u);
     EXPECT_GT(std::abs(f["optimised_achieved"].get<double>() - 194.0), 0.03 * 194.0);
     EXPECT_EQ(r.report["options"]["time_limit_seconds"], 1.0);  // what was asked for
   }
   // One pass of one round misses by far either way (the collapse refuses most of what a single
-  // selection at 0.2 asks for), so the fallback always runs: the greedy run ends at 540, and
+  // selection at 0.2 asks for), so the fallback always runs: the greedy run ends at 526 (540
+  // before issue 32), and
   // the output is whichever of the two is closer to 194.
   SimplifyOptions single = quick(0.2);
   single.max_passes = 1;
@@ -446,11 +497,11 @@ TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
   ASSERT_TRUE(s.ok()) << s.error;
   ASSERT_TRUE(s.report.contains("fallback"));
   const auto& f = s.report["fallback"];
-  EXPECT_EQ(f["greedy_achieved"], 540);
+  EXPECT_EQ(f["greedy_achieved"], 526);
   const auto optimised = f["optimised_achieved"].get<std::int64_t>();
-  EXPECT_EQ(std::int64_t(s.achieved), std::abs(optimised - 194) < std::abs(540 - 194) ? optimised : 540);
+  EXPECT_EQ(std::int64_t(s.achieved), std::abs(optimised - 194) < std::abs(526 - 194) ? optimised : 526);
   EXPECT_EQ(f["kept"], std::int64_t(s.achieved) == optimised ? "optimised" : "greedy");
-  EXPECT_NE(s.note.find("the greedy selection's 540"), std::string::npos) << s.note;
+  EXPECT_NE(s.note.find("the greedy selection's 526"), std::string::npos) << s.note;
   // The note names what held the count up: the costliest refusal kinds of the last pass.
   EXPECT_NE(s.note.find("triangle-equivalents kept by refusal kind: "), std::string::npos) << s.note;
   expect_valid(in.mesh, s.mesh, "suzanne 0.2, one pass");
@@ -480,14 +531,19 @@ TEST(SimplifyCorpus, NoEdgeIsShrunkToAPoint) {
     return shortest;
   };
   ASSERT_GT(shortest_edge(in.mesh), zero);
-  SimplifyOptions o = with_old_lambdas({});
-  o.ratio = 0.2;
-  o.time_limit_seconds = 0.0;
-  const SimplifyResult r = simplify(in.mesh, o);
-  ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_GT(shortest_edge(r.mesh), zero);
-  EXPECT_GT(r.report["collapse"]["refused"]["degenerate_face"].get<int>(), 0);
-  expect_valid(in.mesh, r.mesh, "teeth 0.2");
+  // The scenario of the paper objective with the old lambdas (three shrunk edges before the
+  // guard), and the default one, whose passes meet the guard too (8 refusals since issue 32).
+  for (SimplifyOptions o : {with_old_lambdas({}), SimplifyOptions{}}) {
+    o.ratio = 0.2;
+    o.time_limit_seconds = 0.0;
+    const SimplifyResult r = simplify(in.mesh, o);
+    ASSERT_TRUE(r.ok()) << r.error;
+    EXPECT_GT(shortest_edge(r.mesh), zero) << o.objective;
+    int refused = 0;
+    for (const auto& pass : r.report["passes"]) refused += pass["report"]["collapse"]["refused"]["degenerate_face"].get<int>();
+    if (o.objective == "shape") EXPECT_GT(refused, 0);
+    expect_valid(in.mesh, r.mesh, "teeth 0.2 " + o.objective);
+  }
 }
 #endif
 

@@ -3,6 +3,8 @@
 #include "post/surface_fit.h"
 
 #include "post/cluster_collapse.h"
+#include "mesh/connectivity.h"
+#include "mesh/features.h"
 
 #include "quadlod/generators.h"
 #include "quadlod/metrics.h"
@@ -338,6 +340,59 @@ TEST(SurfaceFit, AnOutputWithALargeNGonIsLeftAsItIs) {
   SurfaceFitParams loose;
   loose.max_face_corners = 64;
   EXPECT_GT(fit_to_surface(input, output, loose).moved_vertices, 0u);  // the same face, allowed
+}
+
+// Issue 32: a vertex on a strict line slides along the input's line, never off it. An 8-sided
+// cylinder fitted to a 64-sided one moves outward (the test above), but its UV seam (angle 0)
+// and its two boundary circles are lines eval holds to the input's (seams_torn): the seam's
+// middle vertex keeps x = 0.5, y = 0 while the other middle vertices move out, the boundary
+// vertices stay on the 64-gon they lie on, and the seam's two ends (corners: seam meets
+// boundary) do not move. Without the lines the same seam vertex leaves the seam.
+TEST(SurfaceFit, AVertexOnAStrictLineSlidesAlongItNeverOffIt) {
+  const PolyMesh input = make_cylinder(64, 8);
+  const PolyMesh coarse = make_cylinder(8, 2);
+  const Connectivity in_conn = build_connectivity(input);
+  const FeatureReference reference = make_feature_reference(input, in_conn, find_feature_edges(input, in_conn));
+  ASSERT_GT(reference.by_kind[0].size(), 0u);  // boundary circles
+  ASSERT_GT(reference.by_kind[2].size(), 0u);  // the seam
+  PolyMesh output = coarse;
+  const Connectivity conn = build_connectivity(output);
+  const FitLines lines = fit_lines(output, conn, find_feature_edges(output, conn), reference);
+  // make_cylinder's vertex (i, j) is j * n + i; the seam is i = 0.
+  auto id = [](Index i, Index j) { return j * 8 + i; };
+  EXPECT_EQ(lines.vertex_kinds[id(0, 1)], kFeatureUvSeam);
+  EXPECT_EQ(lines.corners[id(0, 0)], 1);
+  EXPECT_EQ(lines.corners[id(0, 2)], 1);
+  EXPECT_EQ(lines.vertex_kinds[id(3, 0)], kFeatureBoundary);
+  EXPECT_EQ(lines.corners[id(3, 1)], 0);
+  EXPECT_EQ(lines.vertex_kinds[id(3, 1)], 0);
+
+  SurfaceFitParams params;
+  params.lines = &lines;
+  const SurfaceFitResult r = fit_to_surface(input, output, params);
+  EXPECT_GT(r.moved_vertices, 0u);
+  const Vec3& seam = output.positions[id(0, 1)];
+  EXPECT_NEAR(seam.x(), 0.5, 1e-12);
+  EXPECT_NEAR(seam.y(), 0.0, 1e-12);
+  for (Index i = 1; i < 8; ++i) EXPECT_GT(radius_xy(output.positions[id(i, 1)]), 0.5 + 1e-4) << i;
+  for (Index j : {Index(0), Index(2)}) {
+    EXPECT_EQ(output.positions[id(0, j)], coarse.positions[id(0, j)]);  // corners
+    for (Index i = 1; i < 8; ++i) {
+      const Vec3& p = output.positions[id(i, j)];
+      EXPECT_LT(std::sqrt(reference.by_kind[0].nearest(p).distance_sq), 1e-12) << i << ", " << j;
+    }
+  }
+  // eval's rule holds on every line edge.
+  for (const FitLines::Edge& e : lines.edges) {
+    const Vec3 &a = output.positions[e.v], &b = output.positions[e.w];
+    const int k = e.kinds & kFeatureBoundary ? 0 : 2;
+    for (double t : {0.25, 0.5, 0.75})
+      EXPECT_LE(std::sqrt(reference.by_kind[k].nearest(a + t * (b - a)).distance_sq), 0.2 * (b - a).norm() + 1e-12);
+  }
+
+  PolyMesh free = coarse;
+  fit_to_surface(input, free, {});
+  EXPECT_GT(radius_xy(free.positions[id(0, 1)]), 0.5 + 1e-4);  // off the seam
 }
 
 }  // namespace

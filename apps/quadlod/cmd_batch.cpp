@@ -20,6 +20,7 @@ struct BatchCliOptions {
   bool per_mesh = false, force = false, no_features = false;
   std::string objective;
   std::string recover_quads;
+  std::string seams;
   int threads = -1;
 };
 
@@ -45,6 +46,8 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--objective", opt->objective, "shape or paper")->check(CLI::IsMember({"shape", "paper"}));
   sub->add_option("--recover-quads", opt->recover_quads, "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  sub->add_option("--seams", opt->seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
+      ->check(CLI::IsMember({"auto", "strict"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
   sub->add_option("--shard", opt->shard,
@@ -66,6 +69,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (opt->per_mesh) defaults["per_mesh"] = true;
             if (!opt->objective.empty()) defaults["objective"] = opt->objective;
             if (!opt->recover_quads.empty()) defaults["recover_quads"] = opt->recover_quads;
+            if (!opt->seams.empty()) defaults["seams"] = opt->seams;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
             const bool folder = std::filesystem::is_directory(opt->source);

@@ -49,6 +49,10 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--threads", p.threads, "Threads (0 = all cores)")->check(CLI::Range(0, 256))->capture_default_str()->group("Reduction");
   sub->add_option("--recover-quads", p.recover_quads, "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
       ->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str()->group("Reduction");
+  sub->add_option("--seams", p.seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
+      ->transform(CLI::CheckedTransformer(seam_policy_names(), CLI::ignore_case))
+      ->default_str("auto")
+      ->group("Reduction");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")
       ->group("Reduction");

@@ -136,6 +136,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
+  sub->add_option("--seams", p.seams,
+                  "Strict lines (UV seams, material borders, boundaries) below the budget they leave room for: auto (the "
+                  "lines around the smallest islands may merge through them when a pass stalls, counted in the report), "
+                  "strict (never; the note says how far from the target that stopped)")
+      ->transform(CLI::CheckedTransformer(seam_policy_names(), CLI::ignore_case))
+      ->default_str("auto")
+      ->group("Features");
   sub->add_flag("--place-on-hard-edges", p.place_on_hard_edges,
                 "Keep merged vertices on hard edges (else they follow their quadric, which weighs sharp edges heavily)")
       ->group("Features");
@@ -323,6 +330,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             if (rep.contains("quad_recovery"))
               std::printf("quads: the input is all triangles; %llu pairs were joined into quads first (--recover-quads off keeps them)\n",
                           static_cast<unsigned long long>(rep["quad_recovery"]["quads_made"].get<std::uint64_t>()));
+            if (rep.contains("seams") && rep["seams"]["line_crossings"].get<std::uint64_t>() > 0) {
+              const auto& seams = rep["seams"];
+              const double faces = seams["crossing_island_area"].get<double>() / seams["one_output_face_area"].get<double>();
+              std::printf("seams: %llu line crossings through UV islands of up to %.0f output faces%s (--seams strict keeps every line)\n",
+                          static_cast<unsigned long long>(seams["line_crossings"].get<std::uint64_t>()), faces,
+                          seams["vanishing_part_area"].get<double>() > 0.0 ? "; parts that small may vanish" : "");
+            }
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;
           }};

@@ -15,6 +15,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -137,6 +139,20 @@ struct SimplifyOptions {
   /// merged vertices stay on the feature line they touch, and UVs / normals of moved vertices are
   /// recomputed per wedge. false: the paper's behaviour (features only weigh in the quadrics).
   bool features = true;
+  /// How the strict lines (UV seams, material borders, open boundaries) meet a budget below what
+  /// they leave room for (issue 32; docs/attributes.md, "Lines that shorten"). In both modes a
+  /// line shortens (a collapse along it merges two of its vertices, junctions included, and each
+  /// side keeps its UVs), a collapse across it is refused, every output line stays on its input
+  /// line (within ClusterCollapseParams::feature_tolerance, eval's seams_torn rule), and a UV
+  /// island too small for one output face may vanish.
+  ///   * Auto: as Strict until a pass stalls short of the target; then the lines around islands
+  ///     below one output face may merge through them, the bound growing ×4 per further stall
+  ///     (least texture first), and parts that small may vanish; the report counts the crossings
+  ///     (`seams.line_crossings`) and gives the bounds reached (`seams.crossing_island_area`,
+  ///     `seams.vanishing_part_area`, and per pass).
+  ///   * Strict: never; the note then says how far from the target the run stopped, and why.
+  enum class SeamPolicy : std::uint8_t { Auto, Strict };
+  SeamPolicy seams = SeamPolicy::Auto;
   /// Dihedral angle (degrees) from which a manifold edge is a hard edge (default ϵ_θ).
   double hard_angle_deg = 60.0;
   /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7
@@ -185,6 +201,13 @@ struct SimplifyOptions {
   /// Progress lines on stderr (stage, percent, elapsed).
   bool progress = false;
 };
+
+/// SimplifyOptions::SeamPolicy by name ("auto", "strict"), for the CLI, manifests and Python;
+/// nullopt for any other name.
+std::optional<SimplifyOptions::SeamPolicy> parse_seam_policy(const std::string& name);
+const char* to_string(SimplifyOptions::SeamPolicy policy);
+/// Every name parse_seam_policy takes, with its value.
+std::map<std::string, SimplifyOptions::SeamPolicy> seam_policy_names();
 
 struct SimplifyResult {
   PolyMesh mesh;       ///< the reduced mesh (the input unchanged when nothing is to do)

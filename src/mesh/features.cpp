@@ -294,6 +294,39 @@ UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index 
   return r;
 }
 
+IslandAreas island_areas(const PolyMesh& mesh, const Connectivity& conn, const std::vector<double>* face_island_area,
+                         double per_face_layout_fraction) {
+  IslandAreas r;
+  if (mesh.uv_sets.empty()) return r;
+  r.islands = find_uv_islands(mesh, conn, 0);
+  const Index nf = mesh.num_faces(), n = r.islands.num_islands;
+  if (n == 0) return r;
+  std::vector<Index> size(n, 0);
+  Index with_uv = 0, alone = 0;
+  for (Index f = 0; f < nf; ++f)
+    if (r.islands.face_island[f] != kInvalidIndex) ++size[r.islands.face_island[f]];
+  for (Index f = 0; f < nf; ++f)
+    if (r.islands.face_island[f] != kInvalidIndex) {
+      ++with_uv;
+      alone += size[r.islands.face_island[f]] == 1;
+    }
+  if (double(alone) > per_face_layout_fraction * double(with_uv)) return r;
+  r.area = r.islands.area_3d;
+  if (face_island_area && face_island_area->size() == nf)
+    for (Index f = 0; f < nf; ++f)
+      if (const Index i = r.islands.face_island[f]; i != kInvalidIndex) r.area[i] = std::max(r.area[i], (*face_island_area)[f]);
+  r.exempt = false;
+  return r;
+}
+
+std::vector<std::uint8_t> IslandAreas::faces_below(double bound) const {
+  if (exempt) return {};
+  std::vector<std::uint8_t> below(islands.face_island.size(), 0);
+  for (std::size_t f = 0; f < below.size(); ++f)
+    if (const Index i = islands.face_island[f]; i != kInvalidIndex) below[f] = area[i] > 0.0 && area[i] < bound;
+  return below;
+}
+
 }  // namespace quadlod
 
 namespace quadlod {

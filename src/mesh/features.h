@@ -114,6 +114,26 @@ struct UvIslands {
 /// Precondition: uv_set < mesh.uv_sets.size().
 UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index uv_set);
 
+/// The UV islands (set 0) of a mesh being reduced, each with the area a reduction judges it by:
+/// its largest `face_island_area` entry (the area of the original input island each face comes
+/// from, in a multi-pass reduction) or, without one, its own 3D area. Two bounds read it:
+///   * an island with an area of at least one output face must keep a face (issue 7); smaller
+///     ones may vanish;
+///   * the lines around an island below the crossing bound may merge through it (issue 32): the
+///     island shrinks between its lines, which is how a budget below the lines' own count is met.
+struct IslandAreas {
+  UvIslands islands;          ///< find_uv_islands(mesh, conn, 0)
+  std::vector<double> area;   ///< per island, as above
+  /// True when there is nothing to decide: no UVs, or a per-face layout
+  /// (FeatureParams::per_face_layout_fraction), which must lose islands to be reduced at all.
+  bool exempt = true;
+  /// Per face: 1 when it lies in an island whose area is positive and below `bound` (empty when
+  /// exempt).
+  std::vector<std::uint8_t> faces_below(double bound) const;
+};
+IslandAreas island_areas(const PolyMesh& mesh, const Connectivity& conn, const std::vector<double>* face_island_area,
+                         double per_face_layout_fraction);
+
 }  // namespace quadlod
 
 namespace quadlod {

@@ -20,7 +20,7 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
-                                               "recover_quads"};
+                                               "recover_quads", "seams"};
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -34,6 +34,11 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
     if (options.contains("seed")) simplify.seed = options["seed"].get<std::uint32_t>();
     if (options.contains("features")) simplify.features = options["features"].get<bool>();
     if (options.contains("recover_quads")) simplify.recover_quads = options["recover_quads"].get<std::string>();
+    if (options.contains("seams")) {
+      const auto policy = parse_seam_policy(options["seams"].get<std::string>());
+      if (!policy) return "seams must be auto or strict";
+      simplify.seams = *policy;
+    }
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
     if (options.contains("format")) format = options["format"].get<std::string>();

@@ -46,29 +46,49 @@ int default_swap_rounds() { return ShapeSelectionParams{}.swap_rounds; }
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
 // ratios 0.5 / 0.7 / 0.85 / 0.9 / 0.95 gave Chamfer 0.98 / 0.96 / 0.90 / 0.88 / 0.85 of Single's
 // at 0.4 and 1.12 / 1.06 / 0.98 / 0.95 / 0.94 at 0.2, at 1.0 / 1.1 / 1.5 / 1.8 / 3.1 s in all.
+std::map<std::string, SimplifyOptions::SeamPolicy> seam_policy_names() {
+  return {{"auto", SimplifyOptions::SeamPolicy::Auto}, {"strict", SimplifyOptions::SeamPolicy::Strict}};
+}
+
+std::optional<SimplifyOptions::SeamPolicy> parse_seam_policy(const std::string& name) {
+  const auto names = seam_policy_names();
+  const auto it = names.find(name);
+  if (it == names.end()) return std::nullopt;
+  return it->second;
+}
+
+const char* to_string(SimplifyOptions::SeamPolicy policy) {
+  return policy == SimplifyOptions::SeamPolicy::Strict ? "strict" : "auto";
+}
+
 double default_pass_ratio(const std::string& objective) { return objective == "paper" ? 0.5 : 0.9; }
 int default_max_passes(const std::string& objective) { return objective == "paper" ? 6 : 32; }
 
 namespace {
 
-// Edges the selection must keep so that no cluster can join two strict feature lines or move a
-// strict feature corner (issue 7, docs/attributes.md): a non-feature edge between two vertices on
-// strict lines (collapsing it would merge two seams, or pinch one), and any edge between two
-// feature corners of which one is strict. Chains through interior vertices (a ══ x ══ b with a, b on
-// different seams) are left to the collapse's `feature` refusal: they need two collapsed edges
-// that meet at a vertex, which chord collapses rarely produce.
-std::vector<std::uint8_t> feature_pins(const Connectivity& conn, const FeatureEdges& feat, Index& count) {
+// Edges the selection must keep so that no cluster can join two strict feature lines across a
+// surviving region (issue 7, issue 32; docs/attributes.md): a non-feature edge between two
+// vertices on strict lines (collapsing it would merge two seams, or pinch one), unless its faces
+// lie in UV islands that may vanish (`vanishing`, per face; empty: none). Strict edges are never
+// pinned: collapsing one shortens its line, even between two junctions. Chains through interior
+// vertices (a ══ x ══ b with a, b on different seams) are left to the collapse's `feature`
+// refusal: they need two collapsed edges that meet at a vertex, which chord collapses rarely
+// produce.
+std::vector<std::uint8_t> feature_pins(const Connectivity& conn, const FeatureEdges& feat,
+                                       const std::vector<std::uint8_t>& vanishing, Index& count) {
   std::vector<std::uint8_t> pins(conn.num_edges, 0);
   count = 0;
   for (Index e = 0; e < conn.num_edges; ++e) {
     const auto [a, b] = conn.edge_vertices[e];
     if (a == b) continue;
-    const bool across = !feat.is_strict(e) && feat.on_strict(a) && feat.on_strict(b);
-    const bool corners = feat.vertex_corner[a] && feat.vertex_corner[b] && (feat.on_strict(a) || feat.on_strict(b));
-    if (across || corners) {
-      pins[e] = 1;
-      ++count;
+    if (feat.is_strict(e) || !feat.on_strict(a) || !feat.on_strict(b)) continue;
+    if (!vanishing.empty()) {
+      bool all = true;
+      for (Index c : conn.corners_of_edge(e)) all = all && vanishing[conn.corner_face[c]];
+      if (all) continue;
     }
+    pins[e] = 1;
+    ++count;
   }
   return pins;
 }
@@ -184,7 +204,6 @@ struct PassOutcome {
   Index refusals = 0;
   bool out_of_reach = false;
   std::uint64_t predicted = 0;
-  bool anything_selected = false;  // some round's selection removed something (before the collapse)
   std::int64_t selection_target = 0;
   Index feature_pins = 0;
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
@@ -259,7 +278,12 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
   if (options.features) {
-    pinned = feature_pins(conn, *feat, out.feature_pins);
+    const IslandAreas islands = island_areas(input, conn, cp.face_island_area, cp.features.per_face_layout_fraction);
+    pinned = feature_pins(conn, *feat,
+                          cp.min_kept_island_area < 0.0
+                              ? std::vector<std::uint8_t>()
+                              : islands.faces_below(cp.crossing_island_area),
+                          out.feature_pins);
     pass_cp.feature_edges = &*feat;
     report["features"] = {
         {"feature_edges", feat->feature_edges},
@@ -333,7 +357,6 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     }
     const double select_seconds = clock.seconds();
     out.seconds_select += select_seconds;
-    if (selection.predicted < out.input_tri_equivalent) out.anything_selected = true;
     log.done(2, "select", select_seconds,
              "N' " + std::to_string(selection.predicted) + " of " + std::to_string(selection_target) +
                  (selection.solver_ran ? ", solver " + std::string(ilp::to_string(selection.solve.status)) : "") +
@@ -589,13 +612,22 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   cp.place_on_hard_edges = options.place_on_hard_edges;
   // Islands big enough for one output face must keep one (issue 7): the smallest area an output
   // face can have on average, the input's area over the target's tri-equivalents.
+  double input_area = 0.0;
+  for (Index f = 0; f < input.num_faces(); ++f) input_area += face_area_vector(input, f).norm();
   {
-    double area = 0.0;
-    for (Index f = 0; f < input.num_faces(); ++f) area += face_area_vector(input, f).norm();
     const double target = options.target_tri_equivalent > 0 ? double(options.target_tri_equivalent)
                                                              : options.ratio * double(tri_equivalent_count(input));
-    cp.min_kept_island_area = target > 0.0 ? area / target : 0.0;
+    cp.min_kept_island_area = target > 0.0 ? input_area / target : 0.0;
   }
+  // The lines around islands below this area may merge through them (SeamPolicy::Auto, issue
+  // 32): none until a pass stalls, then one output face (the islands that may vanish anyway),
+  // ×4 per further stall. Crossing from the start made 177 small islands of cg57 vanish at 0.8,
+  // where a mild LOD should keep them (22 without it).
+  double crossing_area = 0.0;
+  // Parts below this area may vanish, and holes close (ClusterCollapseParams::
+  // max_vanishing_part_area): none until a pass stalls, then the crossing bound.
+  double vanishing_part_area = 0.0;
+  Index line_crossings = 0;  // over the passes kept
 
   // Passes (beyond the paper). One global selection can remove only so much: at 20 % of a
   // low-poly character, the clusters of one selection grow so large that the collapse refuses
@@ -642,7 +674,12 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   PassOutcome last;
   nlohmann::json passes = nlohmann::json::array();
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
-  for (int pass = 1; pass <= max_passes; ++pass) {
+  // Passes after a stall (SeamPolicy::Auto) come on top of max_passes, at most this many: the far
+  // LODs of UV-heavy meshes stall late, after the planned passes, and each stall needs a pass to
+  // use its larger crossing bound (tpsdemo_door_reactor at 0.05 ran out of passes at +10.6 %).
+  constexpr int kCrossingPasses = 8;
+  int pass_limit = max_passes;
+  for (int pass = 1; pass <= pass_limit; ++pass) {
     // An upper bound on the run (optional; the output then depends on the clock): once reached,
     // this pass aims at N itself and is the last planned one.
     if (options.time_bound_seconds > 0.0 && pass > 1 && pass < planned &&
@@ -654,7 +691,12 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
         pass < planned ? static_cast<std::uint64_t>(std::llround(n0 * std::pow(n / n0, double(pass) / planned)))
                        : result.target;
     const std::uint64_t pass_in = pass == 1 ? result.input_tri_equivalent : last.achieved;
-    if (pass > 1 && pass_target >= pass_in) break;
+    // A pass that went below the next planned target (parts vanished on the way) skips to the
+    // first planned target below its count; at the target itself, the run is done.
+    if (pass > 1 && pass_target >= pass_in) {
+      if (pass < planned) continue;
+      break;
+    }
     const std::string tag = planned == 1 && pass == 1 ? std::string() : " [pass " + std::to_string(pass) + "]";
     // Islands are protected by their area in the original input (docs/attributes.md).
     std::vector<double> face_island_area;
@@ -666,6 +708,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       }
       cp.face_island_area = &face_island_area;
     }
+    cp.crossing_island_area = crossing_area;
+    cp.max_vanishing_part_area = vanishing_part_area;
     PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag);
     cp.face_island_area = nullptr;
     if (!outcome.error.empty()) {
@@ -681,13 +725,32 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                       {"target", pass_target},
                       {"achieved", outcome.achieved},
                       {"time_limit_seconds", pass_time},
+                      {"crossing_island_area", crossing_area},
+                      {"vanishing_part_area", vanishing_part_area},
                       {"report", outcome.report}});
+    // A pass that removed less than half of what it was asked to, its lines pinning the rest,
+    // stalled: with SeamPolicy::Auto the lines around the next larger islands may then merge
+    // through them (×4 the area per stall, smallest islands first: the least texture lost).
+    const bool stalled = outcome.achieved > pass_target &&
+                         2 * (outcome.achieved - pass_target) > pass_in - std::min(pass_in, pass_target);
+    const bool can_cross = options.seams == SimplifyOptions::SeamPolicy::Auto && options.features &&
+                           crossing_area <= input_area;
+    if (stalled && can_cross) {
+      crossing_area = std::max(4.0 * crossing_area, cp.min_kept_island_area);
+      vanishing_part_area = crossing_area;
+      pass_limit = max_passes + kCrossingPasses;
+    }
     const bool improved = pass <= planned || outcome.achieved < last.achieved;
-    if (!improved) break;  // an extra pass that does not get closer is dropped
-    // A pass whose selection found nothing to remove (every edge pinned: a mesh of lone quads,
-    // all boundary) leaves its input as it was; the next pass would see the same mesh and find
-    // the same nothing, so the run ends here instead of repeating it for every planned pass.
-    const bool stuck = outcome.achieved == pass_in && !outcome.anything_selected;
+    if (!improved) {  // an extra pass that does not get closer is dropped
+      if (stalled && can_cross) continue;
+      break;
+    }
+    // A pass that removed nothing (its selection found nothing, or the collapse refused all of it:
+    // lone triangles whose every collapse takes a part away) leaves its input as it was; the next
+    // pass would see the same mesh and find the same nothing, so the run ends here instead of
+    // repeating it for every planned pass, unless the seams policy lets it cross more lines now.
+    const bool stuck = outcome.achieved == pass_in && !(stalled && can_cross);
+    if (outcome.report.contains("collapse")) line_crossings += outcome.report["collapse"].value("line_crossings", Index{0});
     last = std::move(outcome);
     for (Index& f : last.face_source) f = face_origin[f];
     face_origin = std::move(last.face_source);
@@ -705,6 +768,12 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     if (last.report.contains(key)) report[key] = last.report[key];
   report["passes"] = std::move(passes);
   report["passes_planned"] = planned;
+  // Issue 32: how the strict lines met the budget (SimplifyOptions::seams).
+  report["seams"] = {{"policy", to_string(options.seams)},
+                     {"crossing_island_area", crossing_area},
+                     {"one_output_face_area", cp.min_kept_island_area},
+                     {"vanishing_part_area", vanishing_part_area},
+                     {"line_crossings", line_crossings}};
   report["time_bound_reached"] = time_bound_reached;
   report["stage_seconds"] = {{"analysis", seconds_analysis},
                              {"select", seconds_select},
@@ -719,27 +788,25 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     fp.iterations = options.surface_fit_iterations;
     fp.vertex_weight = options.surface_fit_vertex_weight;
     fp.threads = options.threads;
-    // Vertices on non-manifold edges, UV seams and material borders stay where the collapse put
-    // them (eval holds seams to the input's: seams_torn). Boundary vertices move: the ram's eye
-    // and socket rims are boundaries, and fixing them gave back half the fit's gain on Fig. 10
-    // (docs/benchmarks/fig10-2026-12-03.md).
+    // Vertices on strict lines (boundaries, non-manifold edges, UV seams, material borders) slide
+    // along the input's line and never leave it (eval holds them to it: seams_torn; issue 32);
+    // the corners of those lines stay where the collapse put them. Boundary vertices used to move
+    // freely (the ram's eye and socket rims gave half the fit's gain on Fig. 10), which tore
+    // boundaries (tpsdemo_door_reactor at 0.4: 141 torn, 0 without the fit).
     std::vector<std::uint8_t> fixed;
-    if (options.features) {
+    FitLines lines;
+    if (options.features && reference) {
       const Connectivity out_conn = build_connectivity(current);
-      const FeatureEdges out_feat = find_feature_edges(current, out_conn, cp.features);
-      constexpr std::uint8_t kLines = kFeatureNonManifold | kFeatureUvSeam | kFeatureMaterialBorder;
-      fixed.assign(current.positions.size(), 0);
-      for (Index e = 0; e < out_conn.num_edges; ++e)
-        if (out_feat.edge_bits[e] & kLines)
-          for (Index v : out_conn.edge_vertices[e]) fixed[v] = 1;
-      fp.fixed_vertices = &fixed;
+      lines = fit_lines(current, out_conn, find_feature_edges(current, out_conn, cp.features), *reference);
+      lines.line_tolerance = cp.feature_tolerance;
+      fp.lines = &lines;
     }
     // Measured in poses (skin_poses), a vertex where bones blend was placed for every pose and
     // the fit, which sees only the bind pose, would undo that (the ram at 0.2: posed Hausdorff
     // 3.38e-2 → 3.72e-2 with 2 steps). Only vertices whose faces all follow one bone move: there a
     // pose moves the surface rigidly, and the bind pose's optimum is every pose's.
     if (!options.skin_poses.empty() && !current.skin.empty()) {
-      fixed.resize(current.positions.size(), 0);
+      fixed.assign(current.positions.size(), 0);
       const SkinWeights& w = current.skin;
       auto joint = [&](Index v) { return w.influences(v) == 1 ? w.joint[w.offsets[v]] : kInvalidIndex; };
       for (Index f = 0; f < current.num_faces(); ++f) {
@@ -763,7 +830,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"energy_last_step", fit.energy_last_step},
                              {"moved_vertices", fit.moved_vertices},
                              {"refused_moves", fit.refused_moves},
-                             {"refused_far", fit.refused_far}};
+                             {"refused_far", fit.refused_far},
+                             {"refused_line", fit.refused_line}};
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
     report["stage_seconds"]["fit"] = fit_clock.seconds();
   }
@@ -816,6 +884,9 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                     static_cast<unsigned long long>(result.target), result.passes_used,
                     result.passes_used == 1 ? "" : "es", static_cast<unsigned>(last.refusals));
     result.note = std::string(text) + costliest_refusals();
+    if (options.seams == SimplifyOptions::SeamPolicy::Strict && options.features)
+      result.note += "; with --seams strict no line merges through an island and no part vanishes (--seams auto "
+                     "lets the smallest islands cross when a pass stalls)";
   }
   // UV islands, exactly, from provenance (docs/attributes.md, "Island accounting").
   if (!input.uv_sets.empty() && !result.mesh.uv_sets.empty() && face_origin.size() == result.mesh.num_faces()) {
@@ -874,6 +945,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"surface_fit_iterations", options.surface_fit_iterations},
       {"surface_fit_vertex_weight", options.surface_fit_vertex_weight},
       {"recover_quads", options.recover_quads},
+      {"seams", to_string(options.seams)},
       {"skin_poses", input.skin.empty() ? 0 : options.skin_poses.size()},
       {"max_rounds", options.max_rounds},
       {"round_tolerance", options.round_tolerance},

@@ -106,6 +106,7 @@ void Collapser::precompute() {
       reference_ = &own_reference_;
     }
     protect_islands();
+    protect_parts();
   }
   build_vertex_terms();
 }
@@ -196,6 +197,15 @@ void Collapser::place(Index r) {
 //
 // Returns false when the cluster is not constrained (no feature, or two hard lines meeting: a
 // bevel between creases may collapse, placed by the plain quadric).
+namespace {
+
+// A quadric error below another by more than rounding: members run in increasing id, so a tie
+// (a symmetric pair of corners: the two ends of a strip's collapsed end edge, the columns of a
+// per-face layout's chord) keeps the smaller id, and neighbouring clusters pick the same side.
+bool clearly_less(double err, double best) { return err < best - 1e-9 * std::abs(best); }
+
+}  // namespace
+
 bool Collapser::place_on_feature(Index r, const Quadric& q) {
   Index corners = 0, corner = kInvalidIndex;
   bool strict = false, any = false;
@@ -204,6 +214,9 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
     return feat_ptr_->on_feature(m) &&
            (params_.place_on_hard_edges || (feat_ptr_->vertex_bits[m] & ~std::uint32_t(kFeatureHardEdge)) != 0);
   };
+  Index strict_corner = kInvalidIndex;
+  double strict_corner_err = INFINITY;
+  mark_crossing_side(r);
   for (Index m : members(r)) {
     if (!counts(m)) continue;
     any = true;
@@ -211,9 +224,22 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
     if (feat_ptr_->vertex_corner[m]) {
       ++corners;
       corner = m;
+      // Strict corners (junctions, ends, turns of seams and boundaries) never move: a cluster
+      // that merges several along their lines lands on the one its quadric likes best.
+      // A tie keeps the smaller id (clearly_less), the side mark_crossing_side picks too.
+      const double err = q(mesh_.positions[m]);
+      if (feat_ptr_->on_strict(m) && side_[m] && (strict_corner == kInvalidIndex || clearly_less(err, strict_corner_err))) {
+        strict_corner_err = err;
+        strict_corner = m;
+      }
     }
   }
   if (!any) return false;
+  if (strict_corner != kInvalidIndex) {
+    pos_[r] = mesh_.positions[strict_corner];
+    ++stats_.placements_at_feature_corner;
+    return true;
+  }
   if (corners == 1) {
     pos_[r] = mesh_.positions[corner];
     ++stats_.placements_at_feature_corner;
@@ -230,10 +256,11 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
     if (feat_ptr_->on_feature(m) && !(feat_ptr_->vertex_bits[m] & kFeatureUvSeam)) seams_only = false;
   if (seams_only) {
     double best_err = INFINITY;
+    corner = kInvalidIndex;
     for (Index m : members(r)) {
       if (!feat_ptr_->vertex_corner[m]) continue;
       const double err = q(mesh_.positions[m]);
-      if (err < best_err) {
+      if (corner == kInvalidIndex || clearly_less(err, best_err)) {
         best_err = err;
         corner = m;
       }
@@ -251,7 +278,7 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
     for (Index c : conn_.corners_at_vertex(m))
       for (Index ec : {c, conn_.corner_prev[c]}) {
         const Index e = conn_.corner_edge[ec];
-        if (!feat_ptr_->is_feature(e) || (strict && !feat_ptr_->is_strict(e))) continue;
+        if (!feat_ptr_->is_feature(e) || (strict && (!feat_ptr_->is_strict(e) || !side_[m]))) continue;
         if (!strict) {
           if (line == kInvalidIndex) line = feat_ptr_->edge_line[e];
           else if (feat_ptr_->edge_line[e] != line) return false;
@@ -285,6 +312,44 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
   pos_[r] = best;
   ++stats_.placements_on_feature_line;
   return true;
+}
+
+// The side a crossing lands on. A cluster whose strict members are not all joined by collapsed
+// strict edges merges several lines through an island that may cross (features_valid): it lands
+// on the lines of the part that holds its smallest strict member, so the clusters along a
+// collapsed strip pick the same side of it wherever the vertex order runs the same way along its
+// two sides (rows of a strip are numbered in order by every modeller we read), and the merged
+// line follows one input line instead of zig-zagging across the strip (which check_feature_edges'
+// tolerance would refuse). side_[m] = 1 for the members placement may anchor to.
+void Collapser::mark_crossing_side(Index r) {
+  const auto ms = members(r);
+  if (side_.size() != nv_) side_.assign(nv_, 0);
+  for (Index m : ms) side_[m] = 1;
+  Index first = kInvalidIndex;
+  for (Index m : ms)
+    if (feat_ptr_->on_strict(m)) {
+      first = m;
+      break;
+    }
+  if (first == kInvalidIndex) return;
+  // The strict part of `first`: a walk over collapsed strict edges inside the cluster.
+  for (Index m : ms) side_[m] = feat_ptr_->on_strict(m) ? 0 : 1;
+  std::vector<Index>& stack = side_stack_;
+  stack.assign(1, first);
+  side_[first] = 1;
+  while (!stack.empty()) {
+    const Index m = stack.back();
+    stack.pop_back();
+    for (Index c : conn_.corners_at_vertex(m))
+      for (Index ec : {c, conn_.corner_prev[c]}) {
+        const Index e = conn_.corner_edge[ec];
+        if (!collapsed_[e] || !feat_ptr_->is_strict(e)) continue;
+        const Index o = conn_.other_vertex(e, m);
+        if (root_[o] != r || side_[o]) continue;
+        side_[o] = 1;
+        stack.push_back(o);
+      }
+  }
 }
 
 // --- refusal: splitting a cluster --------------------------------------------------------------
@@ -480,7 +545,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
   round_ = 0;
   for (Index v = 0; v < nv_; ++v)
     if (root_[v] == v && cluster_size(v) > 1) place(v);
-  std::vector<Index> dirty, all_faces;
+  std::vector<Index> dirty;
   for (Index f = 0; f < nf_; ++f) {
     rebuild_face(f);
     stats_.tri_equivalent_in += tri_equivalent(mesh_.face_size(f));
@@ -496,17 +561,14 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
     ++stats_.rounds;
     blamed_.clear();
     check(dirty);
+    if (blamed_.empty() && !part_begin_.empty()) check_parts(all_faces_list());
     if (blamed_.empty() && !face_island_.empty()) {
       // A round can split an island none of whose faces it touched: collapsing a coincident
       // sheet onto an island's edge makes that edge non-manifold (cg57 at 0.6). So before the
       // collapse is final, every island is checked once more — but for those check(dirty) just
       // found whole: nothing changed since (on a UV grid, one island of the whole mesh: a
       // second full check per pass, issue 20).
-      if (all_faces.empty()) {
-        all_faces.resize(nf_);
-        std::iota(all_faces.begin(), all_faces.end(), Index{0});
-      }
-      check_islands(all_faces, /*skip_checked=*/true);
+      check_islands(all_faces_list(), /*skip_checked=*/true);
     }
     if (blamed_.empty()) break;
     // Refuse: split every blamed cluster (they are distinct clusters of this round).
@@ -529,6 +591,16 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
     }
     dirty.swap(next_dirty_);
   }
+  if (features_on_)
+    for (Index r = 0; r < nv_; ++r) {
+      if (root_[r] != r || cluster_size(r) < 2) continue;
+      mark_crossing_side(r);
+      for (Index m : members(r))
+        if (feat_ptr_->on_strict(m) && !side_[m]) {
+          ++stats_.line_crossings;
+          break;
+        }
+    }
   assemble(edge_kept, out);
 }
 
@@ -561,7 +633,7 @@ FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity
   for (int k = 0; k < 4; ++k) {
     segments.clear();
     for (Index e = 0; e < conn.num_edges; ++e)
-      if (feat.is_strict(e) && (feat.edge_bits[e] & kKinds[k]))
+      if ((feat.is_strict(e) || kKinds[k] == kFeatureUvSeam) && (feat.edge_bits[e] & kKinds[k]))
         segments.push_back({mesh.positions[conn.edge_vertices[e][0]], mesh.positions[conn.edge_vertices[e][1]]});
     if (!segments.empty()) ref.by_kind[k] = SegmentBvh(segments);
   }
@@ -581,6 +653,7 @@ const char* to_string(CollapseRefusal reason) {
     case CollapseRefusal::Hausdorff: return "hausdorff";
     case CollapseRefusal::Feature: return "feature";
     case CollapseRefusal::Island: return "island";
+    case CollapseRefusal::Part: return "part";
   }
   return "unknown";
 }
@@ -656,6 +729,7 @@ nlohmann::json to_json(const ClusterCollapseStats& s) {
       {"placements_fallback", s.placements_fallback},
       {"placements_at_feature_corner", s.placements_at_feature_corner},
       {"placements_on_feature_line", s.placements_on_feature_line},
+      {"line_crossings", s.line_crossings},
       {"uv_values_projected", s.uv_values_projected},
       {"normals_recomputed", s.normals_recomputed},
       {"rounds", s.rounds},

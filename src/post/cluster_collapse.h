@@ -57,7 +57,8 @@ namespace quadlod {
 struct FeatureReference {
   std::array<SegmentBvh, 4> by_kind;
 };
-/// The strict edges of `mesh` (features from find_feature_edges on `conn`), sorted by kind.
+/// The strict edges of `mesh` (features from find_feature_edges on `conn`), and all its UV seams (those of
+/// a per-face layout are not strict, but eval holds them to the input's too), sorted by kind.
 FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity& conn, const FeatureEdges& feat);
 
 /// The original input surface, fan-triangulated as `quadlod eval` triangulates it, with each
@@ -160,6 +161,21 @@ struct ClusterCollapseParams {
   /// for one output face may vanish (issue 7). < 0: islands are not checked at all. Per-face layouts
   /// (FeatureParams::per_face_layout_fraction) are never protected.
   double min_kept_island_area = 0.0;
+  /// The lines around a UV island (set 0) whose area is below this may merge through it: its
+  /// strict vertices may join a cluster through its interior edges, and the island may vanish
+  /// even above min_kept_island_area (issue 32, docs/attributes.md). simplify() keeps it 0 until
+  /// a pass stalls on the lines (`--seams auto`; always with `--seams strict`), then sets it to one
+  /// output face and raises it ×4 per further stall. Every output line still stays within
+  /// feature_tolerance of an input line.
+  double crossing_island_area = 0.0;
+  /// With respect_features: a part (a connected component: faces joined through shared
+  /// vertices) whose area is at least this keeps a face, and a loop of open boundary never
+  /// collapses to a point (a hole closed, or a part's outline gone) unless this is positive.
+  /// 0 (default): no part vanishes and no hole closes; a part too small for one output face still
+  /// loses as much as the other rules allow. simplify() raises it with crossing_island_area when a
+  /// pass stalls (SeamPolicy::Auto): a part vanishing costs Hausdorff its whole extent
+  /// (flightgear_cessna337 at 0.4: a 120-face part 0.017 long, 12× the Hausdorff of the rest).
+  double max_vanishing_part_area = 0.0;
   /// Per face of the mesh being collapsed: the 3D area of the island it comes from in the
   /// original input (borrowed; nullptr: the island's own area here). A multi-pass reduction
   /// shrinks islands (a curved part loses area as it is simplified), so an island worth two
@@ -190,8 +206,10 @@ enum class CollapseRefusal : std::uint8_t {
                       ///< boundary zipped shut)
   Island,             ///< a UV island would fall apart into two pieces, or, with at least
                       ///< min_kept_island_area, lose its last face
+  Part,               ///< a part (connected component) of at least max_vanishing_part_area
+                      ///< would lose its last face
 };
-inline constexpr std::size_t kNumCollapseRefusals = 11;
+inline constexpr std::size_t kNumCollapseRefusals = 12;
 const char* to_string(CollapseRefusal reason);
 
 enum class ClusterCollapseStatus : std::uint8_t {
@@ -226,6 +244,10 @@ struct ClusterCollapseStats {
   Index placements_at_feature_corner = 0;   ///< clusters placed at a feature corner: their one, or
                                             ///< the best of several per-face-layout seam corners
   Index placements_on_feature_line = 0;     ///< clusters placed on the feature segments around them
+  /// Output vertices that merge strict lines through an island they may cross (issue 32:
+  /// crossing_island_area): clusters whose strict members are not all joined by collapsed
+  /// strict edges. Each is one crossing of a line.
+  Index line_crossings = 0;
   // Attributes.
   Index uv_values_projected = 0;    ///< new UV values (wedges of moved vertices, all sets)
   Index normals_recomputed = 0;     ///< new normal values (wedges of moved vertices)

@@ -225,41 +225,60 @@ bool Collapser::same_input_vertex_set(Index f, Index g) {
   return tmp_a_ == tmp_b_;
 }
 
-// A cluster may hold at most one strict feature corner, and its members on strict lines must be
-// joined through collapsed strict feature edges: otherwise two seams (boundaries, material
-// borders) would meet in one vertex, or one line would be pinched shut.
+// The strict members of a cluster must be joined inside it through collapsed strict feature
+// edges (a line that shortens: along one line, or along several through the junctions where
+// they meet) or through collapsed edges of UV islands their lines may cross (an island too
+// small for one output face, or below ClusterCollapseParams::crossing_island_area, shrinks
+// between its lines). Otherwise two seams (boundaries,
+// material borders) would meet in one vertex across a surviving region, or one line would be
+// pinched shut. Several strict corners may merge: the cluster lands on the best of them
+// (place_on_feature) and check_feature_edges holds every output line to its input line.
 bool Collapser::features_valid(Index r) {
   const auto ms = members(r);
-  Index strict_members = 0, strict_corners = 0;
-  for (Index m : ms)
-    if (feat_ptr_->on_strict(m)) {
-      ++strict_members;
-      strict_corners += feat_ptr_->vertex_corner[m];
-    }
-  if (strict_corners > 1) return false;
+  Index strict_members = 0;
+  for (Index m : ms) strict_members += feat_ptr_->on_strict(m);
   if (strict_members <= 1) return true;
   const Index b = seg_begin_[r], e = seg_end_[r];
   auto local = [&](Index v) {
     return static_cast<Index>(std::lower_bound(member_list_.begin() + b, member_list_.begin() + e, v) -
                               (member_list_.begin() + b));
   };
-  UnionFind uf(e - b);
-  Index parts = strict_members;
-  for (Index m : ms) {
-    if (!feat_ptr_->on_strict(m)) continue;
+  UnionFind uf(e - b), boundary(e - b);
+  const bool loops_may_close = params_.max_vanishing_part_area > 0.0;
+  for (Index m : ms)
     for (Index c : conn_.corners_at_vertex(m))
       for (Index ec : {c, conn_.corner_prev[c]}) {
         const Index edge = conn_.corner_edge[ec];
-        if (!collapsed_[edge] || !feat_ptr_->is_strict(edge)) continue;
+        if (!collapsed_[edge] || !(feat_ptr_->is_strict(edge) || edge_in_crossable_island(edge))) continue;
         const Index o = conn_.other_vertex(edge, m);
         if (o == m || root_[o] != r) continue;
-        const Index lm = local(m), lo = local(o);
-        if (uf.find(lm) == uf.find(lo)) continue;
-        uf.unite(lm, lo);
-        --parts;
+        uf.unite(local(m), local(o));
+        // A cycle of open-boundary edges inside one cluster: a whole boundary loop collapsed to a
+        // point, a hole closed or a part's outline gone (max_vanishing_part_area). Each boundary
+        // edge is met once from each end; counted from the smaller.
+        if (!loops_may_close && m < o && (feat_ptr_->edge_bits[edge] & kFeatureBoundary)) {
+          if (boundary.find(local(m)) == boundary.find(local(o))) return false;
+          boundary.unite(local(m), local(o));
+        }
       }
+  Index first = kInvalidIndex;
+  for (Index m : ms) {
+    if (!feat_ptr_->on_strict(m)) continue;
+    const Index set = uf.find(local(m));
+    if (first == kInvalidIndex) first = set;
+    else if (set != first) return false;
   }
-  return parts == 1;
+  return true;
+}
+
+// A non-strict edge whose faces all lie in UV islands whose lines may merge through them.
+bool Collapser::edge_in_crossable_island(Index e) const {
+  if (face_island_.empty()) return false;
+  for (Index c : conn_.corners_of_edge(e)) {
+    const Index i = face_island_[conn_.corner_face[c]];
+    if (i == kInvalidIndex || !island_crossable_[i]) return false;
+  }
+  return true;
 }
 
 // Vertex checks around output vertex v: its edges (new non-manifold, new boundary), its fan (new
@@ -406,11 +425,15 @@ void Collapser::check_vertex(Index v) {
 // counts as `seams_torn` (docs/metrics.md §6c): a chord that cuts a curved seam or boundary too
 // short is refused here instead. Uses nbr_ of check_vertex.
 void Collapser::check_feature_edges(Index v) {
-  bool strict_member = false;
-  for (Index m : members(v)) strict_member = strict_member || feat_ptr_->on_strict(m);
-  if (!strict_member) return;
+  // Strict lines, and the UV seams of a per-face layout (not strict, but eval holds them to the
+  // input's seams as any other: seams_torn).
+  auto line_edge = [&](Index e) { return feat_ptr_->is_strict(e) || (feat_ptr_->edge_bits[e] & kFeatureUvSeam); };
+  bool line_member = false;
+  for (Index m : members(v)) line_member = line_member || feat_ptr_->on_strict(m) || (feat_ptr_->vertex_bits[m] & kFeatureUvSeam);
+  if (!line_member) return;
   const double tol = std::max(0.0, params_.feature_tolerance);
   constexpr std::uint8_t kKinds[4] = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam, kFeatureMaterialBorder};
+  line_edges_.clear();
   for (std::size_t i = 0; i < nbr_.size(); ++i) {
     const Index w = nbr_[i].first;
     if (i > 0 && nbr_[i - 1].first == w) continue;
@@ -420,9 +443,10 @@ void Collapser::check_feature_edges(Index v) {
       for (Index c : conn_.corners_at_vertex(m))
         for (Index ec : {c, conn_.corner_prev[c]}) {
           const Index e = conn_.corner_edge[ec];
-          if (feat_ptr_->is_strict(e) && root_[conn_.other_vertex(e, m)] == w) kinds |= feat_ptr_->edge_bits[e];
+          if (line_edge(e) && root_[conn_.other_vertex(e, m)] == w) kinds |= feat_ptr_->edge_bits[e];
         }
     if (!kinds) continue;
+    line_edges_.emplace_back(w, kinds);
     const Vec3 &a = pos_[v], &b = pos_[w];
     const double bound = tol * (b - a).norm() + 1e-12 * diag_;
     bool ok = true;
@@ -434,6 +458,31 @@ void Collapser::check_feature_edges(Index v) {
     if (!ok) {
       blame(v, CollapseRefusal::Feature);
       blame(w, CollapseRefusal::Feature);
+    }
+  }
+  // The other way round, for the lines of the shape (open boundaries, non-manifold edges): every
+  // member on one lies within feature_tolerance of an output edge of its kind at v, so a line
+  // that shortens never cuts off a tip (assimp_suzanne_subdiv at 0.8: two corners at a
+  // boundary's sharp tip merged onto the lower one, and the tip's length became the Hausdorff
+  // distance, 16× the rest). UV seams and material borders may shrink inside the surface: their
+  // islands vanish that way.
+  constexpr std::uint8_t kShape = kFeatureBoundary | kFeatureNonManifold;
+  for (Index m : members(v)) {
+    const std::uint8_t mine = feat_ptr_->vertex_bits[m] & kShape;
+    if (!mine || !feat_ptr_->on_strict(m)) continue;
+    const Vec3& p = mesh_.positions[m];
+    if (p == pos_[v]) continue;
+    bool covered = false, any = false;
+    for (const auto& [w, kinds] : line_edges_) {
+      if (!(kinds & mine)) continue;
+      any = true;
+      const Vec3 &a = pos_[v], &b = pos_[w];
+      const double bound = tol * (b - a).norm() + 1e-12 * diag_;
+      covered = covered || (closest_point_on_segment(p, a, b) - p).squaredNorm() <= bound * bound;
+    }
+    if (any && !covered) {
+      blame(v, CollapseRefusal::Feature);
+      return;
     }
   }
 }
@@ -492,6 +541,7 @@ void Collapser::check(const std::vector<Index>& dirty) {
       verts.push_back(r);
     }
   for (Index v : verts) check_vertex(v);
+  if (!part_begin_.empty()) check_parts(dirty);
   if (!face_island_.empty()) check_islands(dirty);
 }
 

@@ -1,11 +1,13 @@
-// UV islands of the cluster collapse (issue 7; docs/attributes.md, "Islands neither vanish nor
-// split"): which islands Collapser protects, their edge-connected components before and after
-// the collapse, and the check that refuses the clusters that would make an island vanish or fall
-// apart. The class: collapser.h.
+// UV islands and parts of the cluster collapse (issue 7; docs/attributes.md, "Islands neither
+// vanish nor split"; issue 32, "Parts"): which islands and parts Collapser protects, the islands'
+// edge-connected components before and after the collapse, and the checks that refuse the
+// clusters that would make an island vanish or fall apart, or a part vanish. The class:
+// collapser.h.
 #include "mesh/union_find.h"
 #include "post/collapser.h"
 
 #include <algorithm>
+#include <numeric>
 
 namespace quadlod::collapse_detail {
 
@@ -18,21 +20,20 @@ namespace quadlod::collapse_detail {
 // and drops the faces between, with no new boundary and no non-manifold vertex. Per-face layouts
 // are exempt: they must lose islands to be reduced at all.
 void Collapser::protect_islands() {
-  if (mesh_.uv_sets.empty() || params_.min_kept_island_area < 0.0) return;
-  const UvIslands islands = find_uv_islands(mesh_, conn_, 0);
-  std::vector<Index> size(islands.num_islands, 0);
-  Index with_uv = 0, alone = 0;
-  for (Index f = 0; f < nf_; ++f)
-    if (islands.face_island[f] != kInvalidIndex) ++size[islands.face_island[f]];
-  for (Index f = 0; f < nf_; ++f)
-    if (islands.face_island[f] != kInvalidIndex) {
-      ++with_uv;
-      alone += size[islands.face_island[f]] == 1;
-    }
-  if (double(alone) > params_.features.per_face_layout_fraction * double(with_uv)) return;
-  const Index n = islands.num_islands;
-  if (n == 0) return;
-  face_island_ = islands.face_island;
+  if (params_.min_kept_island_area < 0.0) return;
+  IslandAreas k = island_areas(mesh_, conn_, params_.face_island_area, params_.features.per_face_layout_fraction);
+  if (k.exempt) return;
+  const Index n = k.islands.num_islands;
+  island_keep_.assign(n, 0);
+  island_crossable_.assign(n, 0);
+  // An island its lines may cross shrinks between them and may vanish: kept whole, it would
+  // only fall apart where they meet (issue 32).
+  const double keep = std::max(params_.min_kept_island_area, params_.crossing_island_area);
+  for (Index i = 0; i < n; ++i) {
+    island_keep_[i] = k.area[i] > 0.0 && k.area[i] >= keep;
+    island_crossable_[i] = k.area[i] > 0.0 && k.area[i] < params_.crossing_island_area;
+  }
+  face_island_ = std::move(k.islands.face_island);
   island_begin_.assign(n + 1, 0);
   for (Index f = 0; f < nf_; ++f)
     if (face_island_[f] != kInvalidIndex) ++island_begin_[face_island_[f] + 1];
@@ -41,17 +42,9 @@ void Collapser::protect_islands() {
   std::vector<Index> fill(island_begin_.begin(), island_begin_.end() - 1);
   for (Index f = 0; f < nf_; ++f)
     if (face_island_[f] != kInvalidIndex) island_faces_[fill[face_island_[f]]++] = f;
-  island_keep_.assign(n, 0);
   // Every island is one edge-connected piece in the input: find_uv_islands joins faces across
   // the connectivity's edges, and an edge is a vertex pair, so two faces it joins share a side.
   // A split is therefore any island the collapse leaves in more than one piece.
-  for (Index i = 0; i < n; ++i) {
-    double area = islands.area_3d[i];
-    if (params_.face_island_area && params_.face_island_area->size() == nf_)
-      for (Index k = island_begin_[i]; k < island_begin_[i + 1]; ++k)
-        area = std::max(area, (*params_.face_island_area)[island_faces_[k]]);
-    island_keep_[i] = area > 0.0 && area >= params_.min_kept_island_area;
-  }
   island_token_.assign(n, 0);
   root_component_.assign(nv_, kInvalidIndex);
   root_component_token_.assign(nv_, 0);
@@ -183,8 +176,10 @@ void Collapser::check_islands(const std::vector<Index>& dirty, bool skip_checked
     }
     const Index components = island_components(i, piece_component);
     if (components <= 1) continue;
-    // The component of every root on a surviving piece, then the dropped faces touching two.
+    // The component of every root on a surviving piece (and the roots that pieces of two
+    // components share), then the dropped faces touching two.
     ++component_tok_;
+    pinch_roots_.clear();
     Index p = 0;
     for (const Index* g = begin; g != end; ++g) {
       Index off = piece_base(*g);
@@ -195,6 +190,8 @@ void Collapser::check_islands(const std::vector<Index>& dirty, bool skip_checked
           if (root_component_token_[r] != component_tok_) {
             root_component_token_[r] = component_tok_;
             root_component_[r] = piece_component[p];
+          } else if (root_component_[r] != piece_component[p]) {
+            pinch_roots_.push_back(r);
           }
         }
         off += len + 1;
@@ -237,8 +234,82 @@ void Collapser::check_islands(const std::vector<Index>& dirty, bool skip_checked
     if (!blamed_any)  // no dropped face between two pieces: refuse every cluster on a dropped face
       for (const Index* g = begin; g != end; ++g)
         if (piece_count_[*g] == 0)
-          for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) blame(root_of_corner(c), CollapseRefusal::Island);
+          for (Index c = mesh_.face_begin(*g); c < mesh_.face_end(*g); ++c) {
+            blame(root_of_corner(c), CollapseRefusal::Island);
+            blamed_any = true;
+          }
+    // No face dropped at all: the pieces meet at a point only, a cluster that pinched the island
+    // where its two sides merged (a strip whose lines crossed at one rung, issue 32: cg57 at
+    // 0.6). Refuse the clusters that pieces of two components share.
+    if (!blamed_any)
+      for (Index r : pinch_roots_) blame(r, CollapseRefusal::Island);
   }
+}
+
+// Parts (connected components, faces joined through shared vertices, as eval counts them) keep
+// a face unless their area is below max_vanishing_part_area: a part that vanishes takes its
+// whole extent out of the output, and is the Hausdorff point wherever it is larger than the
+// error elsewhere (issue 32: flightgear_cessna337 at 0.4, a 120-face part 0.017 long, once its
+// UV island was allowed to vanish).
+void Collapser::protect_parts() {
+  UnionFind uf(nv_);
+  for (Index f = 0; f < nf_; ++f) {
+    const Index first = mesh_.corner_vertex[mesh_.face_begin(f)];
+    for (Index c = mesh_.face_begin(f) + 1; c < mesh_.face_end(f); ++c) uf.unite(first, mesh_.corner_vertex[c]);
+  }
+  std::vector<Index> part_of_root(nv_, kInvalidIndex);
+  face_part_.assign(nf_, kInvalidIndex);
+  Index n = 0;
+  for (Index f = 0; f < nf_; ++f) {
+    Index& id = part_of_root[uf.find(mesh_.corner_vertex[mesh_.face_begin(f)])];
+    if (id == kInvalidIndex) id = n++;
+    face_part_[f] = id;
+  }
+  std::vector<double> area(n, 0.0);
+  for (Index f = 0; f < nf_; ++f) area[face_part_[f]] += face_area_[f];
+  part_keep_.assign(n, 0);
+  bool any = false;
+  for (Index i = 0; i < n; ++i) {
+    part_keep_[i] = !(area[i] < params_.max_vanishing_part_area);
+    any = any || part_keep_[i];
+  }
+  if (!any) {
+    face_part_.clear();
+    return;
+  }
+  part_begin_.assign(n + 1, 0);
+  for (Index f = 0; f < nf_; ++f) ++part_begin_[face_part_[f] + 1];
+  for (Index i = 0; i < n; ++i) part_begin_[i + 1] += part_begin_[i];
+  part_faces_.resize(nf_);
+  std::vector<Index> fill(part_begin_.begin(), part_begin_.end() - 1);
+  for (Index f = 0; f < nf_; ++f) part_faces_[fill[face_part_[f]]++] = f;
+  part_token_.assign(n, 0);
+}
+
+// Refusal `part`: a part that must keep a face has none left among `faces`' parts. The clusters
+// at the corners of its largest face are refused (split, then dissolved) until that face
+// survives, as for an island.
+void Collapser::check_parts(const std::vector<Index>& faces) {
+  ++part_tok_;
+  for (Index f : faces) {
+    const Index i = face_part_[f];
+    if (part_token_[i] == part_tok_) continue;
+    part_token_[i] = part_tok_;
+    if (!part_keep_[i]) continue;
+    const Index* begin = part_faces_.data() + part_begin_[i];
+    const Index* end = part_faces_.data() + part_begin_[i + 1];
+    if (std::any_of(begin, end, [&](Index g) { return piece_count_[g] > 0; })) continue;
+    const Index* largest = std::max_element(begin, end, [&](Index a, Index b) { return face_area_[a] < face_area_[b]; });
+    for (Index c = mesh_.face_begin(*largest); c < mesh_.face_end(*largest); ++c) blame(root_of_corner(c), CollapseRefusal::Part);
+  }
+}
+
+const std::vector<Index>& Collapser::all_faces_list() {
+  if (all_faces_.size() != nf_) {
+    all_faces_.resize(nf_);
+    std::iota(all_faces_.begin(), all_faces_.end(), Index{0});
+  }
+  return all_faces_;
 }
 
 }  // namespace quadlod::collapse_detail

@@ -60,8 +60,13 @@ class Collapser {
   Index root_of_corner(Index c) const { return root_[conn_.corner_vertex[c]]; }
   void place(Index r);
   bool place_on_feature(Index r, const Quadric& q);
+  void mark_crossing_side(Index r);
+  std::vector<std::uint8_t> side_;  // mark_crossing_side: per vertex, 1 = may anchor the placement
+  std::vector<Index> side_stack_;
   bool features_valid(Index r);
+  bool edge_in_crossable_island(Index e) const;
   void check_feature_edges(Index v);
+  std::vector<std::pair<Index, std::uint8_t>> line_edges_;  // check_feature_edges: {w, kinds}
   void split(Index r, CollapseRefusal why, bool dissolve);
 
   // --- faces -----------------------------------------------------------------------------------
@@ -118,9 +123,12 @@ class Collapser {
   std::vector<Index> face_island_;  // per input face: its island, or kInvalidIndex
   std::vector<Index> island_begin_, island_faces_;  // faces of island i: [begin[i], begin[i+1])
   std::vector<std::uint8_t> island_keep_;   // 1: must keep a face (area >= min_kept_island_area)
+  // 1: its lines may merge through it (area below crossing_island_area or min_kept_island_area)
+  std::vector<std::uint8_t> island_crossable_;
   std::vector<Index> island_token_;
   Index island_tok_ = 0;
   std::vector<Index> root_component_, root_component_token_;  // per root, during check_islands
+  std::vector<Index> pinch_roots_;  // check_islands: roots that pieces of two components share
   // Output sides that two or more pieces of the island being checked lie on, but that do not
   // join them because more than two output faces lie there (find_uv_islands joins faces only
   // across edges with exactly two): {a, b, piece} per piece on such a side.
@@ -135,6 +143,16 @@ class Collapser {
   Index component_tok_ = 0;
   void sort_sides();
   void protect_islands();
+  // Parts (connected components) that must keep a face (max_vanishing_part_area): per face its
+  // part, the faces of part i in [part_begin_[i], part_begin_[i + 1]), and whether it must.
+  std::vector<Index> face_part_, part_begin_, part_faces_;
+  std::vector<std::uint8_t> part_keep_;
+  std::vector<Index> part_token_;
+  Index part_tok_ = 0;
+  void protect_parts();
+  void check_parts(const std::vector<Index>& faces);
+  std::vector<Index> all_faces_;
+  const std::vector<Index>& all_faces_list();
   // skip_checked: leave out the islands the last call checked (nothing changed since).
   void check_islands(const std::vector<Index>& dirty, bool skip_checked = false);
   Index island_components(Index i, std::vector<Index>& piece_component);

@@ -2,6 +2,8 @@
 #include "post/surface_fit.h"
 
 #include "geometry/bvh.h"
+#include "mesh/connectivity.h"
+#include "mesh/features.h"
 #include "post/cluster_collapse.h"
 #include "util/parallel.h"
 
@@ -62,7 +64,58 @@ std::array<double, 3> barycentric(const Vec3& x, const Vec3& a, const Vec3& b, c
   return {1.0 - v - w, v, w};
 }
 
+// The kinds of FeatureReference::by_kind, in its order.
+constexpr std::array<std::uint8_t, 4> kLineKinds = {kFeatureBoundary, kFeatureNonManifold, kFeatureUvSeam,
+                                                    kFeatureMaterialBorder};
+
+// The closest point to p on the input's lines of the first of `kinds` that has any.
+Vec3 onto_line(const FeatureReference& ref, std::uint8_t kinds, const Vec3& p) {
+  for (std::size_t k = 0; k < kLineKinds.size(); ++k)
+    if ((kinds & kLineKinds[k]) && ref.by_kind[k].size() > 0) return ref.by_kind[k].nearest(p).point;
+  return p;
+}
+
+// eval's seams_torn rule for one output line edge a–b: its points at ¼, ½, ¾ lie within
+// tolerance × |ab| of the input's lines of every one of its kinds.
+bool on_input_lines(const FeatureReference& ref, std::uint8_t kinds, const Vec3& a, const Vec3& b, double tolerance,
+                    double slack) {
+  const double bound = tolerance * (b - a).norm() + slack;
+  for (std::size_t k = 0; k < kLineKinds.size(); ++k) {
+    if (!(kinds & kLineKinds[k]) || ref.by_kind[k].size() == 0) continue;
+    for (double t : {0.25, 0.5, 0.75})
+      if (ref.by_kind[k].nearest(a + t * (b - a)).distance_sq > bound * bound) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+FitLines fit_lines(const PolyMesh& output, const Connectivity& conn, const FeatureEdges& features,
+                   const FeatureReference& reference) {
+  FitLines lines;
+  lines.reference = &reference;
+  const Index nv = output.num_vertices();
+  lines.vertex_kinds.assign(nv, 0);
+  lines.corners.assign(nv, 0);
+  std::vector<Index> valence(nv, 0);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    // Strict lines, and the UV seams of a per-face layout (not strict, but held to the input's
+    // seams by eval as any other: without this the fit tore 5–28 seams of opensubdiv_bishop_cage).
+    if (!features.is_strict(e) && !(features.edge_bits[e] & kFeatureUvSeam)) continue;
+    const std::uint8_t kinds = features.edge_bits[e] & kStrictFeatures;
+    const auto [a, b] = conn.edge_vertices[e];
+    lines.edges.push_back({a, b, kinds});
+    for (Index v : {a, b}) {
+      if (valence[v]++ > 0 && lines.vertex_kinds[v] != kinds) lines.corners[v] = 1;
+      lines.vertex_kinds[v] = kinds;
+    }
+  }
+  for (Index v = 0; v < nv; ++v)
+    if (valence[v] > 0 && valence[v] != 2) lines.corners[v] = 1;
+  for (Index v = 0; v < nv; ++v)
+    if (lines.corners[v]) lines.vertex_kinds[v] = 0;
+  return lines;
+}
 
 SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const SurfaceFitParams& params) {
   SurfaceFitResult result;
@@ -252,6 +305,14 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
   // it apart, in flipped_faces_kept, only while its corners stay where they are): its vertices stay.
   std::vector<std::uint8_t> fixed(nv, 0);
   if (params.fixed_vertices && params.fixed_vertices->size() == nv) fixed = *params.fixed_vertices;
+  const FitLines* lines = params.lines && params.lines->reference && params.lines->vertex_kinds.size() == nv &&
+                                  params.lines->corners.size() == nv
+                              ? params.lines
+                              : nullptr;
+  if (lines)
+    for (std::size_t v = 0; v < nv; ++v) fixed[v] = fixed[v] || lines->corners[v];
+  // Slack of the line rule: what eval forgives (kTornAbsoluteSlack, 1e-9 of the bbox's longest side), halved.
+  const double line_slack = 5e-10 * ref.longest_side;
   for (Index f = 0; f < output.num_faces(); ++f)
     if (face_tol[f] < 0.0)
       for (Index v : output.face_vertices(f)) fixed[v] = 1;
@@ -305,6 +366,9 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
           if (out_tris[i].v[k] != v) shortest = std::min(shortest, (before[out_tris[i].v[k]] - before[v]).norm());
       const double cap = params.max_step_edge_fraction * shortest;
       if (d.norm() > cap) d *= cap / d.norm();
+      // A vertex on a strict line slides along the input's line (issue 32): its step is
+      // projected onto it, never off it.
+      if (lines && lines->vertex_kinds[v]) d = onto_line(*lines->reference, lines->vertex_kinds[v], before[v] + d) - before[v];
       if (d.squaredNorm() == 0.0) continue;
       output.positions[v] = before[v] + d;
       moved[v] = 1;
@@ -329,6 +393,22 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
     // (undoing only returns vertices to where they were, so this ends).
     for (bool changed = true; changed;) {
       changed = false;
+      // A line edge that left its input line (eval's seams_torn rule): both ends go back.
+      if (lines)
+        for (const FitLines::Edge& le : lines->edges) {
+          if (!moved[le.v] && !moved[le.w]) continue;
+          if (on_input_lines(*lines->reference, le.kinds, output.positions[le.v], output.positions[le.w],
+                             lines->line_tolerance, line_slack))
+            continue;
+          for (Index v : {le.v, le.w})
+            if (moved[v]) {
+              output.positions[v] = before[v];
+              moved[v] = 0;
+              ++result.refused_moves;
+              ++result.refused_line;
+              changed = true;
+            }
+        }
       for (std::size_t i = 0; i < out_tris.size(); ++i) {
         if (face_ok(static_cast<Index>(i))) continue;
         for (Index v : out_tris[i].v)

@@ -29,6 +29,28 @@
 namespace quadlod {
 
 struct SurfaceReference;  // post/cluster_collapse.h
+struct FeatureReference;  // post/cluster_collapse.h
+struct FeatureEdges;      // mesh/features.h
+struct Connectivity;      // mesh/connectivity.h
+
+/// The strict lines the fit keeps its vertices on (SurfaceFitParams::lines).
+struct FitLines {
+  /// Per output vertex: the kinds (FeatureBit) of the strict line it may slide along, 0 = none.
+  std::vector<std::uint8_t> vertex_kinds;
+  /// Per output vertex: 1 = a corner of the strict lines (a junction, an end, a change of kind),
+  /// which does not move.
+  std::vector<std::uint8_t> corners;
+  /// Output edges on strict lines, with their kinds.
+  struct Edge {
+    Index v, w;
+    std::uint8_t kinds;
+  };
+  std::vector<Edge> edges;
+  /// The input's strict lines by kind (borrowed).
+  const FeatureReference* reference = nullptr;
+  /// ClusterCollapseParams::feature_tolerance: eval's seams_torn rule.
+  double line_tolerance = 0.2;
+};
 
 struct SurfaceFitParams {
   /// Gauss–Newton steps (0 = no fit). Measured on the ram and the corpus at 0.4 (docs/benchmarks/fig10-2026-12-03.md).
@@ -69,10 +91,16 @@ struct SurfaceFitParams {
   /// the input before the fit must still face it, with this slack (× the input's longest bbox
   /// side; ClusterCollapseParams::orientation_tolerance, half of eval's).
   double orientation_tolerance = 5e-4;
-  /// Per output vertex, 1 = it does not move (the pipeline passes the vertices on non-manifold
-  /// edges, UV seams and material borders, whose lines eval holds to the input's: `seams_torn`,
-  /// docs/metrics.md §6c). nullptr or empty: every vertex may move.
+  /// Per output vertex, 1 = it does not move (the pipeline passes the corners of the strict
+  /// feature lines: junctions, ends, a change of kind). nullptr or empty: every vertex may move.
   const std::vector<std::uint8_t>* fixed_vertices = nullptr;
+  /// The strict feature lines of the output (issue 32: boundaries, non-manifold edges, UV seams,
+  /// material borders, which eval holds to the input's: `seams_torn`, docs/metrics.md §6c). A
+  /// vertex on one slides along it, never off it: its step is projected onto the input's lines
+  /// of its kinds (`reference`), and a step after which an output line edge leaves the input line
+  /// by more than `line_tolerance` of its length (sampled at ¼, ½, ¾, as eval samples it) is
+  /// undone for the edge's vertices. nullptr: no line constraint.
+  const FitLines* lines = nullptr;
   /// An output with a face of more corners than this is not fitted (a large n-gon's fan
   /// triangles are not its surface; the fit over a 50 000-corner fan took 75 s).
   Index max_face_corners = 32;
@@ -93,8 +121,15 @@ struct SurfaceFitResult {
   Index moved_vertices = 0;    ///< vertices whose position changed
   Index refused_moves = 0;     ///< vertex moves undone by any guard (summed over steps)
   Index refused_far = 0;       ///< of those, by the Hausdorff guard (max_vertex_distance_fraction)
+  Index refused_line = 0;      ///< of those, because a line edge would leave its input line
   double start_reach = 0.0;    ///< the farthest point before the fit, as the guard measures it
 };
+
+/// The strict lines of `output` (features from find_feature_edges on `conn`) and its UV seams, as
+/// the fit keeps them: a vertex on exactly two such edges of the same kinds slides along them; any
+/// other vertex on one is a corner. `reference`: the input's lines (borrowed).
+FitLines fit_lines(const PolyMesh& output, const Connectivity& conn, const FeatureEdges& features,
+                   const FeatureReference& reference);
 
 /// Fits output.positions to the surface of `input` (both pass check_layout(); faces of any
 /// degree, fan-triangulated). Deterministic for any thread count.

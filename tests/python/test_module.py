@@ -224,6 +224,26 @@ def test_an_all_triangle_input_gets_its_quads_back():
         quadlod.simplify(vertices, tris, ratio=0.5, recover_quads="yes")
 
 
+def test_seams_policy_reaches_the_reduction():
+    """seams (the CLI's --seams): lone triangles meet a budget only by letting small parts vanish,
+    which auto allows once a pass stalls and strict never does."""
+    vertices, faces = [], []
+    for k in range(50):
+        x, y = 2.0 * (k % 10), 2.0 * (k // 10)
+        vertices += [[x, y, 0.0], [x + 1, y, 0.0], [x + 1, y + 1, 0.0]]
+        faces.append([3 * k, 3 * k + 1, 3 * k + 2])
+    vertices, faces = np.array(vertices), np.array(faces)
+    auto = quadlod.simplify(vertices, faces, ratio=0.4)
+    assert auto["report"]["seams"]["policy"] == "auto"
+    assert auto["report"]["achieved"] == 20
+    strict = quadlod.simplify(vertices, faces, ratio=0.4, seams="strict")
+    assert strict["report"]["seams"]["policy"] == "strict"
+    assert strict["report"]["achieved"] == 50
+    assert "with --seams strict" in strict["report"]["note"]
+    with pytest.raises(ValueError, match="seams: 'auto' or 'strict', not 'loose'"):
+        quadlod.simplify(vertices, faces, ratio=0.4, seams="loose")
+
+
 def test_the_input_arrays_are_not_modified():
     vertices, quads, uvs, materials = torus()
     copies = [a.copy() for a in (vertices, quads, uvs, materials)]
