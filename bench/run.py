@@ -5,8 +5,9 @@ k-gon = k - 2, as quadlod counts it) and every result is measured by `quadlod ev
 samples, seed and thread count. Outputs (all written atomically: temporary file, then rename):
 
   OUT/results.csv     one row per (mesh, ratio, method); failures are rows with status=failed
-  OUT/tables.md       Table 1 (methods per ratio), Table 2 (ablations), the bar (quadlod against
-                      Single), losses, validity, failures
+  OUT/tables.md       Table 1 (methods per ratio), Table 2 (ablations), seams and UVs, files as
+                      they are vs bare geometry, the bar (quadlod against Single), losses,
+                      validity, failures
   OUT/fig9_hausdorff.png, OUT/fig9_chamfer.png   QPR against distance (log x), like paper Fig. 9
   OUT/settings.json   the measurement settings and tool versions the rows were measured with
   OUT/runs/MESH/RATIO/METHOD.*   per-run logs, quadlod reports, peer reports, eval JSON
@@ -43,6 +44,9 @@ REPO = os.path.dirname(HERE)
 # name -> (kind, extra quadlod flags or peer mode, label in tables)
 METHODS = {
     "quadlod": ("quadlod", [], "quadlod"),
+    # The corpus file as it is (UVs, normals, materials, groups) instead of the positions +
+    # polygons copy every other method reads (issue 32): quadlod then also keeps seams and borders.
+    "quadlod-full": ("quadlod", [], "quadlod full file"),
     "quadlod-greedy": ("quadlod", ["--time-limit", "0"], "quadlod greedy"),
     # The paper's Eq. 9 (before issue 19's shape objective), greedy and with the default search.
     "quadlod-paper-greedy": ("quadlod", ["--objective", "paper", "--time-limit", "0"], "Eq. 9 greedy"),
@@ -54,20 +58,51 @@ METHODS = {
     "single": ("single", ["default"], "Single"),
     "single-rel": ("single", ["rel"], "Single rel-eps"),
     "meshopt": ("meshopt", [], "meshoptimizer"),
+    # Vertices split by (position, UV): meshoptimizer's seam-aware input (issue 32).
+    "meshopt-uv": ("meshopt", ["--uv"], "meshoptimizer UV"),
     "meshlab": ("meshlab", [], "MeshLab QEC"),
     "blender-collapse": ("blender", ["collapse"], "Blender collapse"),
     "blender-unsubdiv": ("blender", ["unsubdiv"], "Blender un-subdiv"),
 }
 ABLATIONS = ["quadlod-no-consistency", "quadlod-no-segmentation", "quadlod-no-geometry",
              "quadlod-no-dual"]
-PEERS = ["single", "single-rel", "meshopt", "meshlab", "blender-collapse", "blender-unsubdiv"]
-TABLE1_METHODS = ["quadlod", "quadlod-greedy", "quadlod-paper-greedy", "quadlod-paper"] + PEERS
+PEERS = ["single", "single-rel", "meshopt", "meshopt-uv", "meshlab", "blender-collapse",
+         "blender-unsubdiv"]
+TABLE1_METHODS = ["quadlod", "quadlod-full", "quadlod-greedy", "quadlod-paper-greedy",
+                  "quadlod-paper"] + PEERS
+# quadlod methods that reduce the corpus file as it is; every other quadlod method reads the
+# positions + polygons copy (OUT/work/MESH.vf.obj) unless --quadlod-input full.
+FULL_INPUT_METHODS = {"quadlod-full"}
+
+DEFAULT_RATIOS = "0.8,0.6,0.4,0.2,0.1,0.05"
+QUICK_RATIOS = "0.4"
+
+# "files as they are vs bare geometry": quadlod-full against quadlod, and the count of outputs
+# whose achieved count is within this fraction of the target.
+FULL_VS_BARE = ("quadlod-full", "quadlod")
+TARGET_TOLERANCE = 0.03
 
 # Single (Knodt 2025, the author's simple_qem): an external binary, never linked or vendored
 # (../shared/peers/single/README.md). `single-rel` sets --abs-eps to this fraction of the input's
 # bounding-box max extent (the scale-invariant variant that README describes).
 SINGLE_DEFAULT = os.path.normpath(os.path.join(REPO, "..", "shared", "peers", "single", "decimate"))
 SINGLE_REL_EPS = 5e-4
+
+# Seams and UVs (docs/metrics.md §6c), as `quadlod eval --json` names them; bench/uv_compare
+# reads the same keys (and a few more). Empty cells where eval measured no UVs (uv_error_mean
+# null: the output, or the input, has no UVs), e.g. every method that reads or writes positions
+# and polygons only: eval still counts the input's seams and islands there, which would read as
+# "every island vanished".
+UV_COLUMNS = ["seams_torn", "seam_edges_in", "seam_edges_out", "uv_islands_in", "uv_islands_out",
+              "uv_error_mean", "uv_error_max"]
+
+
+def uv_metrics(ev):
+    """The UV_COLUMNS of one `quadlod eval --json` object; all None where it measured no UVs."""
+    if ev.get("uv_error_mean") is None:
+        return {k: None for k in UV_COLUMNS}
+    return {k: ev.get(k) for k in UV_COLUMNS}
+
 
 # The quality bar (--bar-method against --bar-peer, per ratio; see bar_section).
 BAR_QFR_MARGIN = 0.10
@@ -84,6 +119,7 @@ COLUMNS = [
     "zero_length_edges", "zero_length_edges_in",
     "flipped_faces", "flipped_faces_kept", "boundary_edges", "boundary_edges_in", "components", "components_in",
     "flow_deviation_deg", "flow_deviation_p90_deg", "flow_coverage",
+] + UV_COLUMNS + [
     "seconds_read", "seconds_analysis", "seconds_select", "seconds_dual", "seconds_collapse",
     "seconds_write", "seconds_core", "seconds_total", "seconds_eval",
     "time_limit", "solver_status", "solver_gap", "parameter", "note",
@@ -371,8 +407,11 @@ class Bench:
         for m in methods:
             available[m] = METHODS[m][0] == "quadlod"
 
-        if "meshopt" in methods:
-            available["meshopt"] = self._find_meshopt()
+        meshopt_methods = [m for m in methods if METHODS[m][0] == "meshopt"]
+        if meshopt_methods:
+            found = self._find_meshopt(meshopt_methods)
+            for m in meshopt_methods:
+                available[m] = found
         if "meshlab" in methods:
             ml = shutil.which(a.meshlabserver)
             xv = shutil.which("xvfb-run")
@@ -446,8 +485,9 @@ class Bench:
         self.peer_versions["single"] = "simple_qem sha256:%s" % sha256(self.single)[:12]
         return {m: True for m in single_methods}
 
-    def _find_meshopt(self):
+    def _find_meshopt(self, meshopt_methods):
         a = self.args
+        what = "peer meshopt (%s)" % ", ".join(meshopt_methods)
         candidates = [a.meshopt_peer] if a.meshopt_peer else [
             os.path.join(REPO, "build-bench", "quadlod_meshopt_peer"),
             os.path.join(REPO, "build", "quadlod_meshopt_peer")]
@@ -460,7 +500,7 @@ class Bench:
                         ["cmake", "--build", bb, "-j2", "--target", "quadlod_meshopt_peer"]):
                 r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
                 if r.returncode != 0:
-                    log("peer meshopt: skipped (build failed: %s)" % first_error_line(r.stdout))
+                    log("%s: skipped (build failed: %s)" % (what, first_error_line(r.stdout)))
                     return False
         for c in candidates:
             if c and os.path.isfile(c) and os.access(c, os.X_OK):
@@ -468,13 +508,13 @@ class Bench:
                 self.peer_versions["meshoptimizer"] = dpkg_version("libmeshoptimizer-dev")
                 return True
         if a.meshopt_peer:
-            log("peer meshopt: skipped (%s is not an executable)" % a.meshopt_peer)
+            log("%s: skipped (%s is not an executable)" % (what, a.meshopt_peer))
         elif header:
-            log("peer meshopt: skipped (driver not built: bench/run --build-peers, or cmake -S . -B "
+            log("%s: skipped (driver not built: bench/run --build-peers, or cmake -S . -B "
                 "build-bench -G Ninja -DQUADLOD_BUILD_BENCH=ON && cmake --build build-bench "
-                "--target quadlod_meshopt_peer)")
+                "--target quadlod_meshopt_peer)" % what)
         else:
-            log("peer meshopt: skipped (libmeshoptimizer-dev not installed; scripts/bootstrap --peers)")
+            log("%s: skipped (libmeshoptimizer-dev not installed; scripts/bootstrap --peers)" % what)
         return False
 
     # -- CSV ------------------------------------------------------------------------------------
@@ -483,8 +523,18 @@ class Bench:
         if not os.path.exists(self.csv_path):
             return
         with open(self.csv_path, newline="") as f:
-            for r in csv.DictReader(f):
+            reader = csv.DictReader(f)
+            old = not set(UV_COLUMNS) <= set(reader.fieldnames or [])
+            for r in reader:
                 self.rows[(r["mesh"], r["ratio"], r["method"])] = r
+                if old and r.get("status") == "ok":
+                    # Written before the UV columns existed: take them from the run's eval JSON.
+                    ev = os.path.join(self.out, "runs", r["mesh"], r["ratio"], r["method"] + ".eval.json")
+                    try:
+                        with open(ev) as fh:
+                            r.update({k: cell(v) for k, v in uv_metrics(json.load(fh)).items()})
+                    except (OSError, ValueError):
+                        pass
 
     def save_csv(self):
         order = {m: i for i, m in enumerate(METHODS)}
@@ -581,12 +631,14 @@ class Bench:
             kind, extra, _ = METHODS[method]
             if kind == "quadlod":
                 # Every method gets the same clean geometry (positions and polygons, as Single
-                # does) unless --quadlod-input full: with UVs and materials quadlod also keeps
-                # their seams and borders, which no peer is asked to do.
-                src = mesh_path if self.args.quadlod_input == "full" else self.stripped_obj(mesh_path)[0]
+                # does) unless it is quadlod-full or --quadlod-input full: with UVs and materials
+                # quadlod also keeps their seams and borders (meshopt-uv and blender-collapse are
+                # the peers that keep UVs too).
+                full = method in FULL_INPUT_METHODS or self.args.quadlod_input == "full"
+                src = mesh_path if full else self.stripped_obj(mesh_path)[0]
                 output = self._run_quadlod(src, ratio, target, extra, base, row, notes)
             elif kind == "meshopt":
-                output = self._run_meshopt(mesh_path, target, base, row)
+                output = self._run_meshopt(mesh_path, target, extra, base, row)
             elif kind == "meshlab":
                 output = self._run_meshlab(mesh_path, target, base, row)
             elif kind == "blender":
@@ -652,12 +704,15 @@ class Bench:
             notes.append(str(rep["note"]).splitlines()[0])
         return output
 
-    def _run_meshopt(self, mesh_path, target, base, row):
+    def _run_meshopt(self, mesh_path, target, flags, base, row):
         output = base + ".obj"
-        cmd = [self.meshopt_peer, mesh_path, output, "--target-tris", str(target)]
+        cmd = [self.meshopt_peer, mesh_path, output, "--target-tris", str(target)] + flags
         rc, out, err, seconds = self.runner.run(cmd, self.args.timeout, base + ".log")
         row["seconds_total"] = seconds
         if rc != 0:
+            if rc == 1 and flags and "unknown option" in (err or ""):
+                raise RunFailure("meshopt: %s: driver too old for %s (rebuild it: bench/run "
+                                 "--build-peers)" % (exit_text(rc), " ".join(flags)))
             raise RunFailure("meshopt: %s: %s" % (exit_text(rc), first_error_line(err)))
         try:
             rep = json.loads(out)
@@ -667,6 +722,8 @@ class Bench:
         row.update(seconds_read=rep.get("seconds_read"), seconds_write=rep.get("seconds_write"),
                    seconds_core=rep.get("seconds_simplify"),
                    parameter="result_error=%.4g" % rep.get("result_error", float("nan")))
+        if rep.get("dropped_triangles"):  # --uv: zero-area triangles on two copies of one vertex
+            row["parameter"] += "; dropped_triangles=%d" % rep["dropped_triangles"]
         return output
 
     def _run_meshlab(self, mesh_path, target, base, row):
@@ -786,6 +843,7 @@ class Bench:
                    flow_deviation_deg=ev.get("flow_deviation_deg"),
                    flow_deviation_p90_deg=ev.get("flow_deviation_p90_deg"),
                    flow_coverage=ev.get("flow_coverage"))
+        row.update(uv_metrics(ev))
 
     # -- driver ---------------------------------------------------------------------------------
 
@@ -1034,6 +1092,9 @@ def make_tables(rows, settings, bar=None):
             if excluded:
                 out.append("* averages over %d meshes; excluded: %s\n" % (len(common), ", ".join(excluded)))
 
+    out.extend(uv_section(rows))
+    out.extend(full_vs_bare_section(rows, settings))
+
     if bar:
         out.extend(bar)
 
@@ -1051,6 +1112,128 @@ def make_tables(rows, settings, bar=None):
                                                  (r.get("error") or "").replace("|", "\\|")))
     out.append("")
     return "\n".join(out) + "\n"
+
+
+def uv_section(rows):
+    """Seams and UVs per ratio and method (UV_COLUMNS), for the methods with at least one output
+    whose UVs eval measured. Counts and means per ratio run over the meshes where every one of
+    those methods has an ok output with UV metrics at that ratio (as Table 1's averages)."""
+    methods = [m for m in METHODS if any(r["method"] == m and r["status"] == "ok" and
+                                         num(r.get("uv_error_mean")) is not None for r in rows)]
+    out = ["## Seams and UVs\n"]
+    if not methods:
+        out.append("No output with UVs measured (methods that keep UVs: quadlod-full, meshopt-uv, "
+                   "blender-collapse; meshes without UVs give none).\n")
+        return out
+    out.append("Methods whose outputs carry UVs, measured by `quadlod eval` (docs/metrics.md §6c). "
+               "*torn* = output seam or boundary edges that lie on no input seam or boundary "
+               "(`seams_torn`): outputs with any, and their sum; *islands added* = outputs with more "
+               "UV islands than the input (`uv_islands_out > uv_islands_in`: a seam cut through an "
+               "island, or an island pinched apart at a vertex); *UV error* = texture-space distance over the island's UV diagonal, the "
+               "mean over meshes of each output's `uv_error_mean` and `uv_error_max`; *seams out/in* "
+               "= mean of `seam_edges_out / seam_edges_in`. Per ratio over the *meshes* where every "
+               "method listed has an output with UVs (methods that read or write positions and "
+               "polygons only have empty UV cells and are not listed); *with UVs / ok* counts every "
+               "ok output of the method at that ratio.\n")
+    out.append("| ratio | method | meshes | torn: outputs > 0 | torn: sum | islands added: outputs "
+               "| UV error mean | UV error max | seams out/in | with UVs / ok |")
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    notes = []
+    uv_ok = lambda r: r is not None and r["status"] == "ok" and num(r.get("uv_error_mean")) is not None
+    for ratio in sorted({r["ratio"] for r in rows if r["method"] in methods}, key=lambda x: -float(x)):
+        by_m = {m: {r["mesh"]: r for r in rows if r["ratio"] == ratio and r["method"] == m}
+                for m in methods}
+        present = [m for m in methods if any(uv_ok(r) for r in by_m[m].values())]
+        meshes = sorted({x for m in present for x in by_m[m]})
+        common = [x for x in meshes if all(uv_ok(by_m[m].get(x)) for m in present)]
+        if len(common) < len(meshes):
+            notes.append("%s: over %d meshes; excluded (no output with UVs from some method, or a "
+                         "method failed): %s" % (ratio_label(ratio), len(common),
+                                                 ", ".join(x for x in meshes if x not in common)))
+        for m in present:
+            rs = [by_m[m][x] for x in common]
+            torn = [num(r.get("seams_torn")) for r in rs if num(r.get("seams_torn")) is not None]
+            added = sum(1 for r in rs if num(r.get("uv_islands_out")) is not None and
+                        num(r.get("uv_islands_in")) is not None and
+                        num(r["uv_islands_out"]) > num(r["uv_islands_in"]))
+            seams = mean(num(r["seam_edges_out"]) / num(r["seam_edges_in"]) for r in rs
+                         if num(r.get("seam_edges_out")) is not None and num(r.get("seam_edges_in")))
+            ok = [r for r in by_m[m].values() if r["status"] == "ok"]
+            out.append("| %s | %s | %d | %d | %d | %d | %s | %s | %s | %d / %d |" % (
+                ratio_label(ratio).replace(" Δ", ""), METHODS[m][2], len(rs),
+                sum(1 for t in torn if t > 0), sum(torn), added,
+                fmt_sci(mean(num(r.get("uv_error_mean")) for r in rs)),
+                fmt_sci(mean(num(r.get("uv_error_max")) for r in rs)),
+                fmt_fixed(seams, 3), sum(1 for r in ok if uv_ok(r)), len(ok)))
+    out.append("")
+    out.extend("* " + n for n in notes)
+    if notes:
+        out.append("")
+    return out
+
+
+def geomean(xs):
+    xs = [x for x in xs if x is not None and x > 0]
+    return math.exp(sum(math.log(x) for x in xs) / len(xs)) if xs else None
+
+
+def full_vs_bare_section(rows, settings=None):
+    """quadlod-full against quadlod per ratio: geometric means over the meshes where both
+    succeeded of Chamfer(full)/Chamfer(bare) and Hausdorff(full)/Hausdorff(bare), and how many
+    outputs of each land within TARGET_TOLERANCE of the target."""
+    full, bare = FULL_VS_BARE
+    if not any(r["method"] == full for r in rows) or not any(r["method"] == bare for r in rows):
+        return []
+    exact = 1e-12  # distances at or below this are exact reproductions: no meaningful quotient
+    out = ["## Files as they are vs bare geometry\n"]
+    out.append("`%s` reduces the corpus file as it is (UVs, normals, materials, groups: their seams "
+               "and borders are kept), `%s` the positions + polygons copy every peer reads; both are "
+               "measured against the corpus file. Per ratio over the meshes where both succeeded: "
+               "the geometric mean over meshes of the quotients full / bare (> 1: keeping the "
+               "file's attributes costs accuracy), the largest quotient and its mesh, and how many "
+               "outputs of each have achieved within ±%g %% of the target (`achieved_rel_error`; "
+               "over every ok output at that ratio).\n" % (full, bare, 100 * TARGET_TOLERANCE))
+    if settings and settings.get("quadlod_input") == "full":
+        out.append("**Note:** these rows were measured with `--quadlod-input full`: `%s` read the "
+                   "corpus file too, so both columns are the same reduction.\n" % bare)
+    out.append("| ratio | meshes | Chamfer full/bare (geo. mean) | worst (mesh) | Hausdorff full/bare "
+               "(geo. mean) | worst (mesh) | full within ±%g %% | bare within ±%g %% |"
+               % (100 * TARGET_TOLERANCE, 100 * TARGET_TOLERANCE))
+    out.append("|---|---:|---:|---|---:|---|---:|---:|")
+    skipped = []
+
+    def within(rs):
+        ok = [r for r in rs if r["status"] == "ok"]
+        k = sum(1 for r in ok if num(r.get("achieved_rel_error")) is not None and
+                abs(num(r["achieved_rel_error"])) <= TARGET_TOLERANCE + 1e-12)
+        return "%d / %d" % (k, len(ok))
+
+    for ratio in sorted({r["ratio"] for r in rows if r["method"] in FULL_VS_BARE}, key=lambda x: -float(x)):
+        a = {r["mesh"]: r for r in rows if r["ratio"] == ratio and r["method"] == full}
+        b = {r["mesh"]: r for r in rows if r["ratio"] == ratio and r["method"] == bare}
+        both = sorted(x for x in a if x in b and a[x]["status"] == "ok" and b[x]["status"] == "ok")
+        cells = []
+        for key in ("chamfer", "hausdorff"):
+            q = []
+            for x in both:
+                u, v = num(a[x].get(key)), num(b[x].get(key))
+                if u is None or v is None or u <= exact or v <= exact:
+                    skipped.append("%s %s %s" % (ratio_label(ratio).replace(" Δ", ""), x, key))
+                    continue
+                q.append((u / v, x))
+            worst = max(q) if q else None
+            cells.append(fmt_fixed(geomean(v for v, _ in q), 3) +
+                         ("" if len(q) == len(both) else " (%d)" % len(q)))
+            cells.append("–" if worst is None else "%.3f (%s)" % worst)
+        out.append("| %s | %d | %s | %s | %s | %s | %s | %s |" % (
+            ratio_label(ratio).replace(" Δ", ""), len(both), cells[0], cells[1], cells[2], cells[3],
+            within(a.values()), within(b.values())))
+    out.append("")
+    if skipped:
+        out.append("* not in the geometric means (a distance missing or ≤ %g, an exact "
+                   "reproduction; the count in parentheses is the meshes used): %s\n"
+                   % (exact, ", ".join(skipped)))
+    return out
 
 
 def losses_section(rows):
@@ -1265,8 +1448,9 @@ def validity_section(rows):
 # ---------------------------------------------------------------------------------------------
 
 PLOT_METHODS = TABLE1_METHODS
-COLOURS = {"quadlod": "#1f77b4", "quadlod-greedy": "#17becf", "single": "#8c564b",
-           "single-rel": "#e377c2", "meshopt": "#ff7f0e", "meshlab": "#2ca02c",
+COLOURS = {"quadlod": "#1f77b4", "quadlod-full": "#393b79", "quadlod-greedy": "#17becf",
+           "single": "#8c564b", "single-rel": "#e377c2", "meshopt": "#ff7f0e",
+           "meshopt-uv": "#bcbd22", "meshlab": "#2ca02c",
            "blender-collapse": "#d62728", "blender-unsubdiv": "#9467bd"}
 
 
@@ -1419,7 +1603,7 @@ def parse_args(argv):
     p.add_argument("--out", default=None, help="output folder (default out/bench, or "
                                                "out/bench-quick with --quick)")
     p.add_argument("--ratios", default=None, help="comma-separated target ratios "
-                                                  "(default 0.8,0.6,0.4,0.2; --quick: 0.4)")
+                                                  "(default %s; --quick: %s)" % (DEFAULT_RATIOS, QUICK_RATIOS))
     p.add_argument("--methods", default="all",
                    help="comma-separated among: %s; or 'all', 'peers', 'ablations'" % ", ".join(METHODS))
     p.add_argument("--ablation-ratios", default="0.4",
@@ -1442,8 +1626,9 @@ def parse_args(argv):
                    help="configure build-bench/ and build quadlod_meshopt_peer first")
     p.add_argument("--blender", default="blender", help="Blender executable")
     p.add_argument("--quadlod-input", choices=["clean", "full"], default="clean",
-                   help="what quadlod reads: clean = the positions-and-polygons OBJ Single gets "
-                        "(default), full = the corpus file with UVs, normals and materials")
+                   help="what every quadlod method reads: clean = the positions-and-polygons OBJ "
+                        "Single gets (default; quadlod-full still reads the corpus file), full = the "
+                        "corpus file with UVs, normals and materials")
     p.add_argument("--single", default=None,
                    help="Single (Knodt 2025) decimate binary (default $QUADLOD_SINGLE, else "
                         "../shared/peers/single/decimate)")
@@ -1470,7 +1655,7 @@ def parse_args(argv):
     if a.fresh and a.resume:
         p.error("--fresh and --resume exclude each other")
     try:
-        ratios = a.ratios or ("0.4" if a.quick else "0.8,0.6,0.4,0.2")
+        ratios = a.ratios or (QUICK_RATIOS if a.quick else DEFAULT_RATIOS)
         a.ratio_list = [float(x) for x in ratios.split(",") if x.strip()]
     except ValueError:
         p.error("--ratios: not a comma-separated list of numbers: %s" % a.ratios)
@@ -1560,7 +1745,7 @@ def main(argv):
            "quadlod_threads": a.quadlod_threads, "ablation_ratios": a.ablation_ratios,
            "eval_threads": a.eval_threads, "quadlod": bench.quadlod_source,
            "quadlod_sha256": sha256(bench.quadlod), "peer_versions": bench.peer_versions,
-           "host_cpus": os.cpu_count(), "jobs": a.jobs}
+           "host_cpus": os.cpu_count(), "jobs": a.jobs, "quadlod_input": a.quadlod_input}
     if a.fresh:
         for f in (bench.csv_path, settings_path):
             if os.path.exists(f):

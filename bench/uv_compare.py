@@ -2,9 +2,10 @@
 (issue 7).
 
 For every mesh of a folder that has UVs (an `f` record with a `vt` index), at every ratio:
-bench/run reduces it with `quadlod simplify` and with Blender's Decimate modifier in collapse
-mode to the same triangle-equivalent target and measures both with `quadlod eval --json`. This
-script selects the meshes, runs bench/run (methods quadlod and blender-collapse, which keeps
+bench/run reduces it with `quadlod simplify` (the file as it is, with its UVs: bench/run's
+`quadlod-full`) and with Blender's Decimate modifier in collapse mode to the same
+triangle-equivalent target and measures both with `quadlod eval --json`. This script selects the
+meshes, runs bench/run (methods quadlod-full and blender-collapse, which keeps
 bench/run's resuming, timeouts and per-run files), then reads the eval JSON of every run and
 writes (atomically):
 
@@ -26,13 +27,19 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import run as bench_run  # noqa: E402  (bench/run.py: shared CSV and file helpers)
 
-METHODS = ["quadlod", "blender-collapse"]
-LABELS = {"quadlod": "quadlod", "blender-collapse": "Blender collapse"}
+# quadlod-full: quadlod on the corpus file with its UVs (bench/run's `quadlod` reads a positions +
+# polygons copy since the clean-input change, which has no UVs to compare).
+METHODS = ["quadlod-full", "blender-collapse"]
+LABELS = {"quadlod-full": "quadlod", "blender-collapse": "Blender collapse"}
+# bench/run's UV_COLUMNS (the seam/UV keys results.csv also carries), with the island details and
+# the material and feature metrics of eval JSON around them.
+UV = bench_run.UV_COLUMNS
 COLUMNS = [
     "mesh", "ratio", "method", "status", "error", "target", "achieved", "achieved_rel_error",
-    "seams_torn", "seam_edges_in", "seam_edges_out", "uv_islands_in", "uv_islands_out",
+] + UV[:UV.index("uv_islands_out") + 1] + [
     "uv_islands_vanished", "uv_islands_merged", "uv_islands_split",
-    "uv_error_mean", "uv_error_max", "uv_samples", "material_border_error",
+] + UV[UV.index("uv_islands_out") + 1:] + [
+    "uv_samples", "material_border_error",
     "material_mismatch_fraction", "feature_deviation_max", "feature_deviation_mean",
     "hausdorff", "chamfer", "qpr",
 ]
