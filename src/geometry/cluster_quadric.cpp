@@ -57,6 +57,8 @@ VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& c
         if (cosang <= feature_cos) w = std::max(w, params.feature_edge_weight);
       }
     }
+    if (params.texture_line_edges && params.texture_line_edges->size() == ne && (*params.texture_line_edges)[e])
+      w = std::max(w, params.texture_line_edge_weight);
     kind_w[e] = std::max(0.0, std::max(w, params.min_edge_weight));
   }
 

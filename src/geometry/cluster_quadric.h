@@ -43,6 +43,13 @@ struct QuadricPlacementParams {
   /// dihedral / π, i.e. 0.5 for a 90° crease). 60° is the paper's ϵ_θ (§3.2.2).
   double feature_angle_deg = 60.0;
   double feature_edge_weight = 4.0;
+  /// Per mesh edge (borrowed, sized as the connectivity's edges; nullptr: none): 1 on the lines of
+  /// the texture, UV seams and material borders (issue 32). Their planes weigh at least
+  /// `texture_line_edge_weight`, as meshoptimizer weighs attribute seams, so a cluster on such a
+  /// line is placed near it by its quadric alone (the collapse no longer pins it onto the
+  /// polyline; docs/attributes.md, "Lines that shorten").
+  const std::vector<std::uint8_t>* texture_line_edges = nullptr;
+  double texture_line_edge_weight = 1.0;
   /// Pull toward the cluster centroid: each member adds regularization · h² · |x − p_member|².
   /// Makes the 3×3 system positive definite in flat and straight regions. >= 0. It decides the
   /// placement only; the error a cluster is charged (ClusterPlacement::error) leaves it out.

@@ -254,6 +254,14 @@ FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
   return fe;
 }
 
+std::vector<std::uint8_t> texture_line_edges(const FeatureEdges& features) {
+  std::vector<std::uint8_t> lines(features.edge_bits.size(), 0);
+  for (std::size_t e = 0; e < lines.size(); ++e)
+    lines[e] = features.edge_strict[e] && (features.edge_bits[e] & (kFeatureUvSeam | kFeatureMaterialBorder)) &&
+               !(features.edge_bits[e] & (kFeatureBoundary | kFeatureNonManifold));
+  return lines;
+}
+
 UvIslands find_uv_islands(const PolyMesh& mesh, const Connectivity& conn, Index uv_set) {
   const UvSet& set = mesh.uv_sets[uv_set];
   const Index nf = mesh.num_faces();

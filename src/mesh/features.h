@@ -104,6 +104,11 @@ struct FeatureEdges {
 FeatureEdges find_feature_edges(const PolyMesh& mesh, const Connectivity& conn,
                                 const FeatureParams& params = {});
 
+/// Per edge, 1 on the strict lines of the texture: UV seams and material borders that are not
+/// also open boundaries or non-manifold edges (the lines of the shape). Their planes weigh in the
+/// vertex quadrics like a crease (QuadricPlacementParams::texture_line_edges, issue 32).
+std::vector<std::uint8_t> texture_line_edges(const FeatureEdges& features);
+
 /// UV islands of one UV set: faces joined across manifold edges that are not seams of that set.
 struct UvIslands {
   std::vector<Index> face_island;  ///< per face; kInvalidIndex when a corner of it has no UV

@@ -242,14 +242,18 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         out.seconds_analysis = clock.seconds();
       },
       [&] {
-        quadrics = input.skin.empty() || options.skin_poses.empty()
-                       ? build_vertex_quadrics(input, conn, cp.placement)
-                       : build_pose_vertex_quadrics(input, conn, cp.placement, options.skin_poses);
+        QuadricPlacementParams placement = cp.placement;
+        std::vector<std::uint8_t> texture_lines;
         if (options.features) {
           const Stopwatch features_clock;
           feat = find_feature_edges(input, conn, cp.features);
           seconds_features = features_clock.seconds();
+          texture_lines = texture_line_edges(*feat);
+          placement.texture_line_edges = &texture_lines;
         }
+        quadrics = input.skin.empty() || options.skin_poses.empty()
+                       ? build_vertex_quadrics(input, conn, placement)
+                       : build_pose_vertex_quadrics(input, conn, placement, options.skin_poses);
       });
   report["analysis"] = {
       {"seconds", out.seconds_analysis},
@@ -738,7 +742,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     if (stalled && can_cross) {
       crossing_area = std::max(4.0 * crossing_area, cp.min_kept_island_area);
       vanishing_part_area = crossing_area;
-      pass_limit = max_passes + kCrossingPasses;
+      if (options.max_passes < 0) pass_limit = max_passes + kCrossingPasses;  // not when the user set it
     }
     const bool improved = pass <= planned || outcome.achieved < last.achieved;
     if (!improved) {  // an extra pass that does not get closer is dropped

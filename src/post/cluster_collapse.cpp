@@ -122,7 +122,15 @@ void Collapser::build_vertex_terms() {
     terms_ = &params_.vertex_quadrics->terms;
     return;
   }
-  own_quadrics_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, params_.placement);
+  // The texture's lines weigh as in simplify()'s quadrics (QuadricPlacementParams::
+  // texture_line_edges): the collapse places a cluster on them by its quadric alone.
+  QuadricPlacementParams placement = params_.placement;
+  std::vector<std::uint8_t> texture_lines;
+  if (features_on_ && !placement.texture_line_edges) {
+    texture_lines = texture_line_edges(*feat_ptr_);
+    placement.texture_line_edges = &texture_lines;
+  }
+  own_quadrics_ = build_vertex_quadrics(mesh_, conn_, face_n_, face_area_, h_, placement);
   terms_ = &own_quadrics_.terms;
 }
 
@@ -169,6 +177,7 @@ void Collapser::place(Index r) {
   const auto ms = members(r);
   ClusterTerms t;
   for (Index m : ms) t.add_vertex((*terms_)[m], mesh_.positions[m]);
+  snap_edges_.clear();
   if (features_on_) {
     // place_on_feature minimises the regularised quadric along the line.
     if (place_on_feature(r, regularized_quadric(t, h_, params_.placement))) {
@@ -176,9 +185,26 @@ void Collapser::place(Index r) {
       return;
     }
   }
-  const ClusterPlacement pl = place_cluster(t, h_, params_.placement, [&](auto&& visit) {
+  ClusterPlacement pl = place_cluster(t, h_, params_.placement, [&](auto&& visit) {
     for (Index m : ms) visit(mesh_.positions[m]);
   });
+  // A cluster on a texture line whose quadric put it within texture_line_snap of an edge of the
+  // line around it lands on the line: what is left is the regulariser's pull, and on the line
+  // the UVs of each side meet exactly (a flat grid's seam column: 0.0019 off, 0.7 % of an edge).
+  if (!snap_edges_.empty()) {
+    double best = INFINITY, length = 0.0;
+    Vec3 onto = pl.position;
+    for (Index e : snap_edges_) {
+      const auto [a, b] = conn_.edge_vertices[e];
+      const Vec3 q = closest_point_on_segment(pl.position, mesh_.positions[a], mesh_.positions[b]);
+      length += edge_len_[e];
+      if (const double d = (q - pl.position).norm(); d < best) {
+        best = d;
+        onto = q;
+      }
+    }
+    if (best <= params_.texture_line_snap * length / double(snap_edges_.size())) pl.position = onto;
+  }
   stats_.placements_pseudo_inverse += pl.pseudo_inverse;
   stats_.placements_volume_constrained += pl.volume_constrained;
   stats_.placements_fallback += pl.fallback;
@@ -216,11 +242,13 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
   };
   Index strict_corner = kInvalidIndex;
   double strict_corner_err = INFINITY;
+  bool shape_line = false;  // a member on an open boundary or a non-manifold edge
   mark_crossing_side(r);
   for (Index m : members(r)) {
     if (!counts(m)) continue;
     any = true;
     strict = strict || feat_ptr_->on_strict(m);
+    shape_line = shape_line || (feat_ptr_->vertex_bits[m] & (kFeatureBoundary | kFeatureNonManifold));
     if (feat_ptr_->vertex_corner[m]) {
       ++corners;
       corner = m;
@@ -239,6 +267,24 @@ bool Collapser::place_on_feature(Index r, const Quadric& q) {
     pos_[r] = mesh_.positions[strict_corner];
     ++stats_.placements_at_feature_corner;
     return true;
+  }
+  // On the texture's lines only (UV seams, material borders), between their corners: the plain
+  // quadric, with check_feature_edges' tolerance as the guarantee (a cluster whose line edges
+  // leave the input line is refused, and the rounds look elsewhere). Placing such clusters on the
+  // input polyline cost flightgear_caravan 3.8× the Chamfer of its bare geometry at 0.4 (1.2× this
+  // way), with no seam torn either way (docs/attributes.md, "Issue 32"). Boundaries and
+  // non-manifold edges, the lines of the shape, stay on their polyline, and corners stay where
+  // they are.
+  if (strict && !shape_line && !on_line_[r]) {
+    // ... but a placement that lands within texture_line_snap of the line goes onto it (place()),
+    // and one whose line edges leave the input line goes onto it next round (on_line_).
+    placed_free_[r] = 1;
+    snap_edges_.clear();
+    for (Index m : members(r))
+      for (Index c : conn_.corners_at_vertex(m))
+        for (Index ec : {c, conn_.corner_prev[c]})
+          if (const Index e = conn_.corner_edge[ec]; feat_ptr_->is_strict(e)) snap_edges_.push_back(e);
+    return false;
   }
   if (corners == 1) {
     pos_[r] = mesh_.positions[corner];
@@ -524,6 +570,9 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
 
   pos_ = mesh_.positions;
   placed_round_.assign(nv_, kInvalidIndex);
+  placed_free_.assign(nv_, 0);
+  on_line_.assign(nv_, 0);
+  replace_round_.assign(nv_, kInvalidIndex);
   blame_reason_.assign(nv_, kNoReason);
   vert_token_.assign(nv_, 0);
   stack_pos_.assign(nv_, kInvalidIndex);
@@ -560,6 +609,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
   while (true) {
     ++stats_.rounds;
     blamed_.clear();
+    replace_.clear();
     check(dirty);
     if (blamed_.empty() && !part_begin_.empty()) check_parts(all_faces_list());
     if (blamed_.empty() && !face_island_.empty()) {
@@ -570,7 +620,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
       // second full check per pass, issue 20).
       check_islands(all_faces_list(), /*skip_checked=*/true);
     }
-    if (blamed_.empty()) break;
+    if (blamed_.empty() && replace_.empty()) break;
     // Refuse: split every blamed cluster (they are distinct clusters of this round).
     const bool dissolve = round_ >= params_.max_bisect_rounds;
     ++dirty_token_;
@@ -583,10 +633,24 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
     }
     ++round_;
     for (Index r : to_place_) place(r);
+    // Clusters going onto their texture line (place_on_line_again), unless a split this round
+    // took them apart: placed again, their faces checked again.
+    for (Index r : replace_) {
+      if (root_[r] != r || cluster_size(r) < 2 || placed_round_[r] == round_) continue;
+      place(r);
+      for (Index m : members(r))
+        for (Index c : conn_.corners_at_vertex(m)) {
+          const Index f = conn_.corner_face[c];
+          if (face_dirty_token_[f] == dirty_token_) continue;
+          face_dirty_token_[f] = dirty_token_;
+          next_dirty_.push_back(f);
+        }
+    }
     for (Index f : next_dirty_) {
       const std::int64_t before = face_tri_eq_[f];
       rebuild_face(f);
-      stats_.refused_tri_equivalents[face_blame_[f]] += std::int64_t(face_tri_eq_[f]) - before;
+      if (face_blame_[f] != kNoReason)
+        stats_.refused_tri_equivalents[face_blame_[f]] += std::int64_t(face_tri_eq_[f]) - before;
       face_blame_[f] = kNoReason;
     }
     dirty.swap(next_dirty_);

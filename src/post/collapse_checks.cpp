@@ -456,8 +456,13 @@ void Collapser::check_feature_edges(Index v) {
         ok = ok && reference_->by_kind[k].nearest(a + t * (b - a)).distance_sq <= bound * bound;
     }
     if (!ok) {
-      blame(v, CollapseRefusal::Feature);
-      blame(w, CollapseRefusal::Feature);
+      // A cluster its quadric placed off its texture line goes onto the line next round instead
+      // (place_on_line_again); only a placement on the line that still fails is refused.
+      const bool v_back = place_on_line_again(v), w_back = place_on_line_again(w);
+      if (!v_back && !w_back) {
+        blame(v, CollapseRefusal::Feature);
+        blame(w, CollapseRefusal::Feature);
+      }
     }
   }
   // The other way round, for the lines of the shape (open boundaries, non-manifold edges): every
@@ -485,6 +490,18 @@ void Collapser::check_feature_edges(Index v) {
       return;
     }
   }
+}
+
+// A cluster on a texture line that its quadric placed off the line (placed_free_) and whose line
+// edges leave the input line: placed on the line next round (on_line_, replace_) instead of
+// refused. False when it already was on the line.
+bool Collapser::place_on_line_again(Index r) {
+  if (!placed_free_[r]) return false;
+  if (on_line_[r]) return replace_round_[r] == round_;  // already going onto it this round
+  on_line_[r] = 1;
+  replace_round_[r] = round_;
+  replace_.push_back(r);
+  return true;
 }
 
 // One-sided distance bound (documented approximation of the Hausdorff distance): the placed vertex

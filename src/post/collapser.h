@@ -61,6 +61,12 @@ class Collapser {
   void place(Index r);
   bool place_on_feature(Index r, const Quadric& q);
   void mark_crossing_side(Index r);
+  std::vector<Index> snap_edges_;  // place_on_feature → place: the texture line around a cluster
+  // Per root: placed by its quadric although on a texture line (placed_free_); to be placed on
+  // the line (on_line_) after its line edges failed the tolerance, in the next round (replace_).
+  std::vector<std::uint8_t> placed_free_, on_line_;
+  std::vector<Index> replace_, replace_round_;
+  bool place_on_line_again(Index r);
   std::vector<std::uint8_t> side_;  // mark_crossing_side: per vertex, 1 = may anchor the placement
   std::vector<Index> side_stack_;
   bool features_valid(Index r);
