@@ -732,10 +732,11 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                       {"crossing_island_area", crossing_area},
                       {"vanishing_part_area", vanishing_part_area},
                       {"report", outcome.report}});
-    // A pass that removed less than half of what it was asked to, its lines pinning the rest,
-    // stalled: with SeamPolicy::Auto the lines around the next larger islands may then merge
+    // A pass that removed less than half of what it was asked to, its lines pinning the rest, and
+    // ended more than 3 % above its target, stalled: with SeamPolicy::Auto the lines around the next larger islands may then merge
     // through them (×4 the area per stall, smallest islands first: the least texture lost).
-    const bool stalled = outcome.achieved > pass_target &&
+    constexpr double kStallMiss = 0.03;  // a miss within issue 32's budget band crosses no line
+    const bool stalled = double(outcome.achieved) > (1.0 + kStallMiss) * double(pass_target) &&
                          2 * (outcome.achieved - pass_target) > pass_in - std::min(pass_in, pass_target);
     const bool can_cross = options.seams == SimplifyOptions::SeamPolicy::Auto && options.features &&
                            crossing_area <= input_area;
@@ -753,7 +754,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     // lone triangles whose every collapse takes a part away) leaves its input as it was; the next
     // pass would see the same mesh and find the same nothing, so the run ends here instead of
     // repeating it for every planned pass, unless the seams policy lets it cross more lines now.
-    const bool stuck = outcome.achieved == pass_in && !(stalled && can_cross);
+    // (A pass whose target was within kStallMiss of its input, which removed nothing, is not stuck:
+    // the next planned pass asks for more.)
+    const bool near = double(outcome.achieved) <= (1.0 + kStallMiss) * double(pass_target);
+    const bool stuck = outcome.achieved == pass_in && !near && !(stalled && can_cross);
     if (outcome.report.contains("collapse")) line_crossings += outcome.report["collapse"].value("line_crossings", Index{0});
     last = std::move(outcome);
     for (Index& f : last.face_source) f = face_origin[f];
