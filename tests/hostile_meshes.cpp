@@ -126,7 +126,7 @@ void chord_crossings(int crossings, std::vector<Vertex>& vertices, std::vector<F
 
 }  // namespace
 
-std::vector<HostileCase> catalogue() {
+std::vector<HostileCase> catalogue(int components) {
   std::vector<HostileCase> cases;
   const auto add = [&](std::string name, std::string ext, std::string description, Expect expect,
                        std::string message_has, std::uint64_t faces, std::function<void(const fs::path&)> write,
@@ -230,17 +230,19 @@ std::vector<HostileCase> catalogue() {
           }
         write_obj(p, v, f);
       });
-  add("components_100k", ".obj", "100 000 separate one-quad components", either, "", 100000, [](const fs::path& p) {
+  add("components_" + std::to_string(components / 1000) + "k", ".obj",
+      std::to_string(components / 1000) + " 000 separate one-quad components", either, "", components,
+      [components](const fs::path& p) {
     std::vector<Vertex> v;
     std::vector<Face> f;
-    for (int k = 0; k < 100000; ++k) {
+    for (int k = 0; k < components; ++k) {
       const double x = (k % 400) * 2.0, y = (k / 400) * 2.0;
       const std::int64_t b = std::int64_t(v.size());
       for (auto [dx, dy] : {std::pair{0, 0}, {1, 0}, {1, 1}, {0, 1}}) v.push_back({x + dx, y + dy, 0.0});
       f.push_back({b, b + 1, b + 2, b + 3});
     }
     write_obj(p, v, f);
-  }, 400000);
+  }, 4 * std::uint64_t(components));
   add("chord_crossing_1000", ".obj", "one closed poly-chord crossing itself 1000 times", either, "", 5000, [](const fs::path& p) {
     std::vector<Vertex> v;
     std::vector<Face> f;
