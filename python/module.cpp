@@ -251,7 +251,7 @@ PYBIND11_MODULE(_core, m) {
   using namespace quadlod::python;
   namespace py = pybind11;
   m.doc() = "quadlod: quad-dominant mesh reduction that keeps edge loops (C++ core).";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = QUADLOD_VERSION;  // CMake's project(VERSION), as the wheel's (setup.py)
   static py::exception<MeshInputError> error(m, "QuadlodError", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
