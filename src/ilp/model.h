@@ -239,7 +239,7 @@ namespace quadlod::ilp {
 /// the row bounds and the objective offset, rows left without a column are dropped. Backends
 /// would presolve them away too, but loading and presolving tens of thousands of fixed columns
 /// costs more than solving a small neighbourhood (the large-neighbourhood search of
-/// src/ilp/neighbourhoods.cpp solves such models by the hundred).
+/// src/select/neighbourhoods.cpp solves such models by the hundred).
 struct ReducedModel {
   Model model;
   std::vector<Col> kept;         ///< reduced column → original column

@@ -50,7 +50,7 @@ struct SolveParams {
   /// Stop when branch-and-bound has gone this many wall-clock seconds without a better
   /// incumbent (counted from the start of branch-and-bound or from the last improvement), > 0;
   /// kInf = never. The result is then Feasible with `stalled` set. For searches that will not
-  /// close their gap in the budget (src/ilp/formulation.cpp: whole-model selections), so that a
+  /// close their gap in the budget (src/select/formulation.cpp: whole-model selections), so that a
   /// solve which has stopped finding anything does not sit out the whole time limit.
   double stall_seconds = kInf;
   /// Tolerance of the re-check every solution goes through (Model::max_violation, absolute).
@@ -63,7 +63,7 @@ struct SolveParams {
   /// 12 of 12 runs. A good start (e.g. a previous solution) helps through its cutoff.
   bool start_as_mip_start = true;
   /// Plain branch-and-bound: no cut generation, no primal heuristics, no pre-processing. For
-  /// many small MIPs with a good start (the neighbourhoods of src/ilp/neighbourhoods.cpp), where
+  /// many small MIPs with a good start (the neighbourhoods of src/select/neighbourhoods.cpp), where
   /// those stages cost more than the search (CBC: ~70 ms per call on a 100-group neighbourhood).
   bool light = false;
   /// Run the backend in a child process (POSIX fork; the CBC backend). A crash inside the solver

@@ -1,5 +1,5 @@
 // The decision space of the edge selection (paper §3.2; internal to src/select/ and the model
-// builder of src/ilp/formulation.cpp): decision groups (Eq. 4), the geometric constraints of
+// builder of src/select/formulation.cpp): decision groups (Eq. 4), the geometric constraints of
 // Eqs. 6–8 and the face terms of Eq. 1 in group space, the incremental SelectionState every
 // search works on, and Eq. 1 / Eq. 9 evaluated on group bits.
 #pragma once

@@ -5,7 +5,7 @@
 // selection in the band was found, and the report; also the test entry point detail::local_search.
 #include "select/selection.h"
 
-#include "ilp/formulation.h"
+#include "select/formulation.h"
 #include "ilp/solver.h"
 #include "select/anneal.h"
 #include "select/greedy.h"
@@ -83,7 +83,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   // in the band; otherwise the solver has to find a feasible point itself, with half of what is
   // left of the budget. Phase 2 (only if phase 1 ends without a solution): no band, the
   // selection nearest the band as start, so the result is the closest count found (reported in
-  // `note`). A solve is solve_model() (src/ilp/formulation.h); neighbourhood_search() there is
+  // `note`). A solve is solve_model() (src/select/formulation.h); neighbourhood_search() there is
   // the large-neighbourhood search of SelectionParams::Strategy.
 
   // The whole model is built before the local search, so that the annealing's and the descent's

@@ -19,7 +19,7 @@
 //
 // The stage's interface. The search (groups, greedy, local-search moves, annealing,
 // recombination, select_edges()) is in src/select/, the MIP models and their solves in
-// src/ilp/formulation.{h,cpp} and src/ilp/neighbourhoods.cpp (docs/architecture.md).
+// src/select/formulation.{h,cpp} and src/select/neighbourhoods.cpp (docs/architecture.md).
 #pragma once
 
 #include "ilp/solver.h"

@@ -23,7 +23,7 @@
 // That replaces three rows per quad by three rows per group. Faces of one group are linear,
 // triangles of several groups get an AND variable, and the rest (quads cut by breakpoints on both
 // pairs, n-gons) get the paper's per-face rows.
-#include "ilp/formulation.h"
+#include "select/formulation.h"
 
 #include "ilp/solver.h"
 #include "util/progress.h"

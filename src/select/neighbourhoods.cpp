@@ -1,7 +1,7 @@
 // The large-neighbourhood search of the edge selection (SelectionParams::Strategy; beyond the
 // paper, docs/formulation.md, "Speed"): sweeps of neighbourhood MIPs of the fast model (§3.2)
 // around the incumbent, and the test entry point detail::neighbourhood_model (selection.h).
-#include "ilp/formulation.h"
+#include "select/formulation.h"
 
 #include "ilp/solver.h"
 #include "util/progress.h"
