@@ -1,5 +1,8 @@
 // Batch runs (issue 21): shards are disjoint and cover the assets, reruns skip what is done,
 // a failing asset makes the exit code non-zero while the others complete, manifests.
+// Issue 36: resuming after a kill at any moment — a skipped job repeats its recorded result, a
+// stale or half-rewritten output is redone, temp files left by SIGKILL are removed by the next
+// run, and `quadlod batch` SIGKILLed at random moments then resumed ends where one run ends.
 #include "cli_runner.h"
 
 #include "quadlod/batch.h"
@@ -9,8 +12,16 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <csignal>
+#include <functional>
 #include <map>
+#include <random>
+#include <set>
 #include <sstream>
+#include <thread>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace quadlod;
 using namespace quadlod::testing;
@@ -169,4 +180,319 @@ TEST_F(Batch, RecoverQuadsReachesEachJobAndIsChecked) {
   EXPECT_EQ(quads(dir / "out" / "off.obj"), 0);
   // The folder mode's --recover-quads is checked by the command line.
   EXPECT_EQ(run_cli("-q batch assets -o out2 --ratio 0.5 --recover-quads maybe", dir).exit_code, 1);
+}
+
+// ---- Issue 36: resume after a kill at any moment -----------------------------------------------
+
+namespace {
+
+/// A line without what differs between runs: its status (done / skipped) and every time.
+nlohmann::json without_times(nlohmann::json j) {
+  if (j.is_object()) {
+    nlohmann::json kept = nlohmann::json::object();
+    for (auto& [key, value] : j.items())
+      if (key != "status" && !key.ends_with("seconds")) kept[key] = without_times(value);
+    return kept;
+  }
+  if (j.is_array())
+    for (auto& e : j) e = without_times(e);
+  return j;
+}
+
+/// The dot-named temp files (write_file_atomically: .NAME.tmp-PID-HEX) anywhere under `root`.
+std::vector<fs::path> temporaries_under(const fs::path& root) {
+  std::vector<fs::path> found;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) found.push_back(e.path());
+  return found;
+}
+
+void set_mtime_ago(const fs::path& p, std::chrono::seconds ago) {
+  fs::last_write_time(p, fs::file_time_type::clock::now() - ago);
+}
+
+}  // namespace
+
+TEST_F(Batch, ASkippedLineRepeatsTheRecordedResult) {
+  make_assets();
+  const BatchJob reduce{asset(0), dir / "out" / "t0.obj", {{"ratio", 0.5}}};
+  const BatchJob chain{asset(1), dir / "out" / "t1", {{"levels", {0.5, 0.25}}}};
+  for (const BatchJob& job : {reduce, chain}) {
+    SCOPED_TRACE(job.output.string());
+    EXPECT_FALSE(batch_output_is_current(job));
+    const nlohmann::json done = run_batch_job(job, {});
+    ASSERT_EQ(done["status"], "done") << done.dump();
+    EXPECT_TRUE(fs::is_regular_file(batch_record_path(job)));
+    EXPECT_TRUE(batch_output_is_current(job));
+    const nlohmann::json skipped = run_batch_job(job, {});
+    EXPECT_EQ(skipped["status"], "skipped");
+    EXPECT_EQ(without_times(skipped), without_times(done));
+    // --force redoes it, to the same result.
+    const nlohmann::json forced = run_batch_job(job, {.force = true});
+    EXPECT_EQ(forced["status"], "done");
+    EXPECT_EQ(without_times(forced), without_times(done));
+  }
+  // Known answers: t0 is a 12×8 torus, 96 quads = 192 triangle-equivalents, half is 96.
+  EXPECT_EQ(batch_record_path(reduce), dir / "out" / ".t0.obj.batch.json");
+  EXPECT_EQ(batch_record_path(chain), dir / "out" / ".t1.batch.json");
+  const nlohmann::json again = run_batch_job(reduce, {});
+  EXPECT_EQ(again["input_tri_equivalent"], 192);
+  EXPECT_EQ(again["target"], 96);
+  // A chain given as "out/t1/" is the same job with the same record.
+  BatchJob slash = chain;
+  slash.output = dir / "out" / "t1" / "";
+  EXPECT_EQ(batch_record_path(slash), batch_record_path(chain));
+  EXPECT_EQ(run_batch_job(slash, {})["status"], "skipped");
+}
+
+// Each case below was "skipped" by the rule before issue 36 (output not older than the input),
+// leaving a stale or foreign output reported as done; each must be redone to its known result.
+TEST_F(Batch, StaleOutputsAreRedoneNotSkipped) {
+  make_assets();
+  const BatchJob job{asset(0), dir / "out" / "t0.obj", {{"ratio", 0.5}}};
+  ASSERT_EQ(run_batch_job(job, {})["status"], "done");
+  const std::string half = slurp(job.output);
+  BatchJob quarter_job = job;
+  quarter_job.options["ratio"] = 0.25;
+  quarter_job.output = dir / "ref" / "t0.obj";
+  ASSERT_EQ(run_batch_job(quarter_job, {})["status"], "done");
+  const std::string quarter = slurp(quarter_job.output);
+  ASSERT_NE(half, quarter);
+
+  // Threads do not change the output: still current.
+  BatchJob threaded = job;
+  threaded.options["threads"] = 2;
+  EXPECT_EQ(run_batch_job(threaded, {})["status"], "skipped");
+
+  // Other options: redone, to the other ratio's bytes (known: 192 / 4 = 48).
+  BatchJob changed = job;
+  changed.options["ratio"] = 0.25;
+  nlohmann::json line = run_batch_job(changed, {});
+  EXPECT_EQ(line["status"], "done");
+  EXPECT_EQ(line["target"], 48);
+  EXPECT_EQ(slurp(job.output), quarter);
+  EXPECT_EQ(run_batch_job(changed, {})["status"], "skipped");
+
+  // The output replaced after its record (a later run killed between the output's rename and
+  // its record, or an edit): newer than the input, but not what the record vouches for.
+  ASSERT_EQ(run_batch_job(job, {})["status"], "done");
+  ASSERT_EQ(slurp(job.output), half);
+  write_text(job.output, quarter);
+  EXPECT_FALSE(batch_output_is_current(job));
+  EXPECT_EQ(run_batch_job(job, {})["status"], "done");
+  EXPECT_EQ(slurp(job.output), half);
+
+  // The output removed, the record kept: redone.
+  fs::remove(job.output);
+  EXPECT_EQ(run_batch_job(job, {})["status"], "done");
+  EXPECT_EQ(slurp(job.output), half);
+
+  // No record (a run killed before writing it), or a torn one: redone.
+  fs::remove(batch_record_path(job));
+  EXPECT_EQ(run_batch_job(job, {})["status"], "done");
+  write_text(batch_record_path(job), "{\"quadlod_batch_record\": 1, \"opt");
+  EXPECT_EQ(run_batch_job(job, {})["status"], "done");
+  EXPECT_EQ(run_batch_job(job, {})["status"], "skipped");
+
+  // The input replaced by another mesh dated an hour back (cp -p, git checkout, rsync -t): older
+  // than the output, yet the output is stale. Known: a 14×8 torus, 224 → 112.
+  ASSERT_TRUE(write_mesh(make_torus(14, 8), asset(0)).ok());
+  set_mtime_ago(asset(0), std::chrono::hours(1));
+  line = run_batch_job(job, {});
+  EXPECT_EQ(line["status"], "done");
+  EXPECT_EQ(line["input_tri_equivalent"], 224);
+  EXPECT_EQ(line["target"], 112);
+  EXPECT_EQ(run_batch_job(job, {})["status"], "skipped");
+}
+
+TEST_F(Batch, AChainRewrittenInPartIsRedone) {
+  make_assets();
+  const BatchJob chain{asset(1), dir / "out" / "t1", {{"levels", {0.5, 0.25}}, {"format", ".obj"}}};
+  const nlohmann::json first = run_batch_job(chain, {});
+  ASSERT_EQ(first["status"], "done") << first.dump();
+  const fs::path lod1 = chain.output / "t1.lod1.obj", lod2 = chain.output / "t1.lod2.obj";
+  const std::string bytes1 = slurp(lod1), bytes2 = slurp(lod2);
+  ASSERT_FALSE(bytes1.empty());
+  // A later run that got as far as its first level (lods.json and the record still the old ones,
+  // as a run before issue 36 left them): the old rule saw lods.json and skipped.
+  write_text(lod1, bytes2);
+  EXPECT_FALSE(batch_output_is_current(chain));
+  nlohmann::json line = run_batch_job(chain, {});
+  EXPECT_EQ(line["status"], "done");
+  EXPECT_EQ(without_times(line), without_times(first));
+  EXPECT_EQ(slurp(lod1), bytes1);
+  // A level lost: redone.
+  fs::remove(lod2);
+  EXPECT_EQ(run_batch_job(chain, {})["status"], "done");
+  EXPECT_EQ(slurp(lod2), bytes2);
+  EXPECT_EQ(run_batch_job(chain, {})["status"], "skipped");
+}
+
+// A SIGKILL in the middle of write_file_atomically (hit on purpose, as in test_interrupt.cpp)
+// leaves its temp file; the next run of that job removes it, and the temp files of the job's
+// record and chain, but not another output's in the same folder.
+TEST_F(Batch, TempFilesLeftBySigkillAreRemovedByTheNextRun) {
+  make_assets();
+  const BatchJob reduce{asset(0), dir / "out" / "t0.obj", {{"ratio", 0.5}}};
+  const BatchJob chain{asset(1), dir / "out" / "t1", {{"levels", {0.5}}}};
+  fs::create_directories(dir / "out" / "t1");
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const std::string contents(std::size_t{128} << 20, 'x');
+    ::_exit(write_file_atomically(reduce.output, contents).ok() ? 0 : 1);
+  }
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (temporaries_under(dir / "out").empty() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the write finished before the kill";
+  const std::vector<fs::path> left = temporaries_under(dir / "out");
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_TRUE(left[0].filename().string().starts_with(".t0.obj.tmp-" + std::to_string(pid) + "-")) << left[0];
+  EXPECT_FALSE(fs::exists(reduce.output));  // the rename never happened
+
+  // What else a SIGKILL can leave: the record's temp, a chain's level and lods.json temps.
+  write_text(dir / "out" / "..t0.obj.batch.json.tmp-77-beef", "{");
+  write_text(dir / "out" / "t1" / ".t1.lod1.glb.tmp-12-ab", "glTF");
+  write_text(dir / "out" / "t1" / ".lods.json.tmp-12-cd", "{");
+  // Not this job's: another output's temp in the shared folder, and names not of the pattern.
+  write_text(dir / "out" / ".t5.obj.tmp-1-2", "x");
+  write_text(dir / "out" / ".t0.obj.tmp-notours", "x");
+  write_text(dir / "out" / ".t0.obj.tmp-1-2.obj", "x");
+
+  EXPECT_EQ(run_batch_job(reduce, {})["status"], "done");
+  EXPECT_EQ(run_batch_job(chain, {})["status"], "done");
+  std::set<std::string> remaining;
+  for (const fs::path& p : temporaries_under(dir / "out")) remaining.insert(p.filename().string());
+  EXPECT_EQ(remaining, (std::set<std::string>{".t5.obj.tmp-1-2", ".t0.obj.tmp-notours", ".t0.obj.tmp-1-2.obj"}));
+  EXPECT_LT(fs::file_size(reduce.output), std::size_t{1} << 20);  // the reduction, not the killed write
+
+  // A skipped job cleans up too.
+  write_text(dir / "out" / ".t0.obj.tmp-5-a", "x");
+  EXPECT_EQ(remove_batch_temporaries(reduce), 1u);
+  write_text(dir / "out" / ".t0.obj.tmp-5-a", "x");
+  EXPECT_EQ(run_batch_job(reduce, {})["status"], "skipped");
+  EXPECT_FALSE(fs::exists(dir / "out" / ".t0.obj.tmp-5-a"));
+}
+
+// `quadlod batch` SIGKILLed (and SIGTERMed) at seeded random moments, each run resuming the
+// previous one's state: after every kill, every job that counts as done (by its record, or by a
+// line the killed run printed) has exactly the reference output; the final run ends with the
+// reference's outputs byte for byte, its lines field for field (times aside), and no temp file.
+TEST_F(Batch, KilledAtAnyMomentThenResumedEndsAsOneRun) {
+  make_assets();
+  std::string manifest;
+  for (Index i = 0; i < 7; ++i) {
+    std::string stem(1, 't');  // not "t" + string: GCC 12 warns of a bogus overflow
+    stem += std::to_string(i);
+    const std::string in = "../assets/" + stem + ".obj";
+    if (i % 3 == 2)
+      manifest += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + "\", \"levels\": [0.5, 0.25]}\n";
+    else
+      manifest += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + (i % 3 ? ".glb" : ".ply") +
+                  "\", \"ratio\": " + (i % 2 ? "0.4" : "0.6") + "}\n";
+  }
+  manifest += "{\"input\": \"../assets/missing.obj\", \"output\": \"out/missing.obj\", \"ratio\": 0.5}\n";
+  for (const char* run : {"ref", "run"}) {
+    fs::create_directories(dir / run);
+    write_text(dir / run / "jobs.jsonl", manifest);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun ref = run_cli("-q batch '" + (dir / "ref" / "jobs.jsonl").string() + "'", dir);
+  const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(ref.exit_code, 2) << ref.err;  // the missing input
+  const BatchPlan plan = plan_batch_manifest(dir / "run" / "jobs.jsonl", {});
+  const BatchPlan ref_plan = plan_batch_manifest(dir / "ref" / "jobs.jsonl", {});
+  ASSERT_TRUE(plan.ok() && ref_plan.ok());
+  ASSERT_EQ(plan.jobs.size(), 8u);
+
+  // A job's files: name → size and hash of the bytes (a chain: every file in its directory but
+  // lods.json, which holds times; a temp file there counts too).
+  const auto files_of = [](const BatchJob& job) {
+    std::map<std::string, std::string> files;
+    const auto digest = [](const fs::path& p) {
+      const std::string bytes = slurp(p);
+      return std::to_string(bytes.size()) + " bytes, hash " + std::to_string(std::hash<std::string>{}(bytes));
+    };
+    if (fs::is_directory(job.output)) {
+      for (const auto& e : fs::directory_iterator(job.output))
+        if (e.path().filename() != "lods.json") files[e.path().filename().string()] = digest(e.path());
+    } else if (fs::exists(job.output)) {
+      files[job.output.filename().string()] = digest(job.output);
+    }
+    return files;
+  };
+  std::vector<std::map<std::string, std::string>> expected;
+  for (const BatchJob& job : ref_plan.jobs) expected.push_back(files_of(job));
+  for (std::size_t k = 0; k + 1 < expected.size(); ++k) ASSERT_FALSE(expected[k].empty()) << k;
+
+  const fs::path run_out = dir / "run" / "run.stdout";
+  std::mt19937 rng(36);
+  std::uniform_real_distribution<double> moment(0.0, 1.1 * run_seconds);
+  int killed = 0, finished = 0, done_lines_checked = 0;
+  // Each trial resumes the state the previous kill left; every third starts from nothing and
+  // every third is a --force rerun (old outputs being replaced), so that the kills land in
+  // first writes, in resumed runs and in rewrites.
+  for (int trial = 0; trial < 12; ++trial) {
+    const int signal_number = trial % 4 == 3 ? SIGTERM : SIGKILL;
+    const bool force = trial % 3 == 2;
+    SCOPED_TRACE("trial " + std::to_string(trial) + ", signal " + std::to_string(signal_number) +
+                 (force ? ", --force" : ""));
+    if (trial % 3 == 0) fs::remove_all(dir / "run" / "out");
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      std::freopen(run_out.c_str(), "w", stdout);
+      std::freopen("/dev/null", "w", stderr);
+      ::execl(QUADLOD_CLI_PATH, QUADLOD_CLI_PATH, "-q", "batch", (dir / "run" / "jobs.jsonl").c_str(),
+              force ? "--force" : "-q", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::duration<double>(moment(rng)));
+    ::kill(pid, signal_number);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    WIFSIGNALED(status) ? ++killed : ++finished;
+    // Whatever counts as done now must be exactly the reference's.
+    for (std::size_t k = 0; k < plan.jobs.size(); ++k)
+      if (batch_output_is_current(plan.jobs[k])) {
+        EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << plan.jobs[k].output;
+      }
+    std::istringstream printed(slurp(run_out));
+    for (std::string text; std::getline(printed, text);) {
+      const nlohmann::json l = nlohmann::json::parse(text, nullptr, false);
+      if (l.is_discarded() || l["status"] != "done") continue;  // a line cut by the kill
+      ++done_lines_checked;
+      for (std::size_t k = 0; k < plan.jobs.size(); ++k)
+        if (plan.jobs[k].output.string() == l["output"].get<std::string>()) {
+          EXPECT_TRUE(batch_output_is_current(plan.jobs[k])) << l.dump();
+          EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << l.dump();
+        }
+    }
+  }
+  std::printf("batch kills: %d runs killed, %d finished first, %d done lines checked\n", killed, finished,
+              done_lines_checked);
+  EXPECT_GE(killed, 6);  // the fresh and forced runs are killed before their end but by chance
+
+  const CliRun last = run_cli("-q batch '" + (dir / "run" / "jobs.jsonl").string() + "'", dir);
+  EXPECT_EQ(last.exit_code, 2) << last.err;
+  const auto got = lines(last.out), want = lines(ref.out);
+  ASSERT_EQ(got.size(), want.size());
+  const auto relative = [&](nlohmann::json l, const char* run) {
+    for (const char* key : {"input", "output"}) l[key] = fs::relative(l[key].get<std::string>(), dir / run).string();
+    if (l.contains("error")) {
+      std::string e = l["error"].get<std::string>();
+      const std::string prefix = (dir / run).string() + "/";
+      for (std::size_t at; (at = e.find(prefix)) != std::string::npos;) e.erase(at, prefix.size());
+      l["error"] = e;
+    }
+    return without_times(l);
+  };
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    EXPECT_EQ(relative(got[k], "run"), relative(want[k], "ref"));
+    EXPECT_EQ(got[k]["status"] == "failed", want[k]["status"] == "failed") << got[k].dump();
+    EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << plan.jobs[k].output;
+  }
+  EXPECT_TRUE(temporaries_under(dir / "run").empty()) << temporaries_under(dir / "run").front();
 }
