@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <functional>
@@ -378,35 +379,44 @@ TEST_F(Batch, TempFilesLeftBySigkillAreRemovedByTheNextRun) {
 }
 
 // `quadlod batch` SIGKILLed (and SIGTERMed) at seeded random moments, each run resuming the
-// previous one's state: after every kill, every job that counts as done (by its record, or by a
-// line the killed run printed) has exactly the reference output; the final run ends with the
-// reference's outputs byte for byte, its lines field for field (times aside), and no temp file.
+// state the previous kill left, over the same outputs with two option sets A and B (a rerun with
+// changed options rewrites every output; a chain killed in the middle of that is the case the
+// rule before issue 36 called done). A moment is "after the run printed k lines, plus d ms" (k, d
+// seeded): the run is inside asset k+1, its write, or between assets, however fast the machine
+// (a moment drawn from a measured run time was not: under load, runs ended before it). After
+// every kill, every job that counts as done for A or for B (by its record, or by a line the
+// killed run printed) has exactly that option set's reference files; a last run of A ends with
+// A's reference outputs byte for byte, its lines field for field (times aside), no temp file.
 TEST_F(Batch, KilledAtAnyMomentThenResumedEndsAsOneRun) {
   make_assets();
-  std::string manifest;
-  for (Index i = 0; i < 7; ++i) {
-    std::string stem(1, 't');  // not "t" + string: GCC 12 warns of a bogus overflow
-    stem += std::to_string(i);
-    const std::string in = "../assets/" + stem + ".obj";
-    if (i % 3 == 2)
-      manifest += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + "\", \"levels\": [0.5, 0.25]}\n";
-    else
-      manifest += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + (i % 3 ? ".glb" : ".ply") +
-                  "\", \"ratio\": " + (i % 2 ? "0.4" : "0.6") + "}\n";
-  }
-  manifest += "{\"input\": \"../assets/missing.obj\", \"output\": \"out/missing.obj\", \"ratio\": 0.5}\n";
-  for (const char* run : {"ref", "run"}) {
-    fs::create_directories(dir / run);
-    write_text(dir / run / "jobs.jsonl", manifest);
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  const CliRun ref = run_cli("-q batch '" + (dir / "ref" / "jobs.jsonl").string() + "'", dir);
-  const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const auto manifest = [](bool b) {
+    std::string text;
+    for (Index i = 0; i < 7; ++i) {
+      std::string stem(1, 't');  // not "t" + string: GCC 12 warns of a bogus overflow
+      stem += std::to_string(i);
+      const std::string in = "../assets/" + stem + ".obj";
+      if (i % 3 == 2)
+        text += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + "\", \"levels\": " +
+                (b ? "[0.6, 0.3]" : "[0.5, 0.25]") + "}\n";
+      else
+        text += "{\"input\": \"" + in + "\", \"output\": \"out/" + stem + (i % 3 ? ".glb" : ".ply") +
+                "\", \"ratio\": " + (i % 2 ? "0.4" : "0.6") + (b ? "5" : "") + "}\n";
+    }
+    return text + "{\"input\": \"../assets/missing.obj\", \"output\": \"out/missing.obj\", \"ratio\": 0.5}\n";
+  };
+  for (const char* folder : {"refA", "refB", "run"}) fs::create_directories(dir / folder);
+  write_text(dir / "refA" / "jobs.jsonl", manifest(false));
+  write_text(dir / "refB" / "jobs.jsonl", manifest(true));
+  write_text(dir / "run" / "A.jsonl", manifest(false));
+  write_text(dir / "run" / "B.jsonl", manifest(true));
+  const CliRun ref = run_cli("-q batch '" + (dir / "refA" / "jobs.jsonl").string() + "'", dir);
   ASSERT_EQ(ref.exit_code, 2) << ref.err;  // the missing input
-  const BatchPlan plan = plan_batch_manifest(dir / "run" / "jobs.jsonl", {});
-  const BatchPlan ref_plan = plan_batch_manifest(dir / "ref" / "jobs.jsonl", {});
-  ASSERT_TRUE(plan.ok() && ref_plan.ok());
-  ASSERT_EQ(plan.jobs.size(), 8u);
+  ASSERT_EQ(run_cli("-q batch '" + (dir / "refB" / "jobs.jsonl").string() + "'", dir).exit_code, 2);
+  const BatchPlan plans[2] = {plan_batch_manifest(dir / "run" / "A.jsonl", {}),
+                              plan_batch_manifest(dir / "run" / "B.jsonl", {})};
+  const BatchPlan ref_plans[2] = {plan_batch_manifest(dir / "refA" / "jobs.jsonl", {}),
+                                  plan_batch_manifest(dir / "refB" / "jobs.jsonl", {})};
+  for (const BatchPlan& p : {plans[0], plans[1], ref_plans[0], ref_plans[1]}) ASSERT_TRUE(p.ok() && p.jobs.size() == 8u);
 
   // A job's files: name → size and hash of the bytes (a chain: every file in its directory but
   // lods.json, which holds times; a temp file there counts too).
@@ -424,58 +434,77 @@ TEST_F(Batch, KilledAtAnyMomentThenResumedEndsAsOneRun) {
     }
     return files;
   };
-  std::vector<std::map<std::string, std::string>> expected;
-  for (const BatchJob& job : ref_plan.jobs) expected.push_back(files_of(job));
-  for (std::size_t k = 0; k + 1 < expected.size(); ++k) ASSERT_FALSE(expected[k].empty()) << k;
+  std::vector<std::map<std::string, std::string>> expected[2];
+  for (int b = 0; b < 2; ++b)
+    for (const BatchJob& job : ref_plans[b].jobs) expected[b].push_back(files_of(job));
+  for (std::size_t k = 0; k + 1 < expected[0].size(); ++k) {
+    ASSERT_FALSE(expected[0][k].empty()) << k;
+    ASSERT_NE(expected[0][k], expected[1][k]) << k;  // B really rewrites every output
+  }
 
   const fs::path run_out = dir / "run" / "run.stdout";
   std::mt19937 rng(36);
-  std::uniform_real_distribution<double> moment(0.0, 1.1 * run_seconds);
-  int killed = 0, finished = 0, done_lines_checked = 0;
-  // Each trial resumes the state the previous kill left; every third starts from nothing and
-  // every third is a --force rerun (old outputs being replaced), so that the kills land in
-  // first writes, in resumed runs and in rewrites.
+  std::uniform_int_distribution<int> after_lines(0, 6);      // of 8: the last is the missing input
+  std::uniform_real_distribution<double> then_ms(0.0, 20.0);  // an asset takes 10-100 ms here
+  const auto printed_lines = [&] {
+    const std::string text = slurp(run_out);
+    return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  };
+  int killed = 0, finished = 0, done_lines_checked = 0, current_checked = 0;
+  // A A B B A A B B …: every other trial changes the options; trials 0 and 6 start from nothing,
+  // trials 5 and 9 are --force reruns, every fourth is a SIGTERM.
   for (int trial = 0; trial < 12; ++trial) {
+    const int b = trial % 4 >= 2;
     const int signal_number = trial % 4 == 3 ? SIGTERM : SIGKILL;
-    const bool force = trial % 3 == 2;
-    SCOPED_TRACE("trial " + std::to_string(trial) + ", signal " + std::to_string(signal_number) +
+    const bool force = trial == 5 || trial == 9;
+    SCOPED_TRACE("trial " + std::to_string(trial) + (b ? ", B" : ", A") + ", signal " + std::to_string(signal_number) +
                  (force ? ", --force" : ""));
-    if (trial % 3 == 0) fs::remove_all(dir / "run" / "out");
+    if (trial == 0 || trial == 6) fs::remove_all(dir / "run" / "out");
+    const fs::path manifest_path = dir / "run" / (b ? "B.jsonl" : "A.jsonl");
     const pid_t pid = ::fork();
     if (pid == 0) {
       std::freopen(run_out.c_str(), "w", stdout);
       std::freopen("/dev/null", "w", stderr);
-      ::execl(QUADLOD_CLI_PATH, QUADLOD_CLI_PATH, "-q", "batch", (dir / "run" / "jobs.jsonl").c_str(),
-              force ? "--force" : "-q", static_cast<char*>(nullptr));
+      ::execl(QUADLOD_CLI_PATH, QUADLOD_CLI_PATH, "-q", "batch", manifest_path.c_str(), force ? "--force" : "-q",
+              static_cast<char*>(nullptr));
       ::_exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::duration<double>(moment(rng)));
-    ::kill(pid, signal_number);
+    const int k = after_lines(rng);
+    const double d = then_ms(rng);
     int status = 0;
-    ::waitpid(pid, &status, 0);
+    bool ended = false;
+    while (!(ended = ::waitpid(pid, &status, WNOHANG) == pid) && printed_lines() < k)
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+    if (!ended) {
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(d));
+      ::kill(pid, signal_number);
+      ::waitpid(pid, &status, 0);
+    }
     WIFSIGNALED(status) ? ++killed : ++finished;
-    // Whatever counts as done now must be exactly the reference's.
-    for (std::size_t k = 0; k < plan.jobs.size(); ++k)
-      if (batch_output_is_current(plan.jobs[k])) {
-        EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << plan.jobs[k].output;
-      }
+    // Whatever counts as done now, for either option set, must be exactly that set's reference.
+    for (int set = 0; set < 2; ++set)
+      for (std::size_t j = 0; j < plans[set].jobs.size(); ++j)
+        if (batch_output_is_current(plans[set].jobs[j])) {
+          ++current_checked;
+          EXPECT_EQ(files_of(plans[set].jobs[j]), expected[set][j]) << (set ? "B " : "A ") << plans[set].jobs[j].output;
+        }
     std::istringstream printed(slurp(run_out));
     for (std::string text; std::getline(printed, text);) {
       const nlohmann::json l = nlohmann::json::parse(text, nullptr, false);
       if (l.is_discarded() || l["status"] != "done") continue;  // a line cut by the kill
       ++done_lines_checked;
-      for (std::size_t k = 0; k < plan.jobs.size(); ++k)
-        if (plan.jobs[k].output.string() == l["output"].get<std::string>()) {
-          EXPECT_TRUE(batch_output_is_current(plan.jobs[k])) << l.dump();
-          EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << l.dump();
+      for (std::size_t j = 0; j < plans[b].jobs.size(); ++j)
+        if (plans[b].jobs[j].output.string() == l["output"].get<std::string>()) {
+          EXPECT_TRUE(batch_output_is_current(plans[b].jobs[j])) << l.dump();
+          EXPECT_EQ(files_of(plans[b].jobs[j]), expected[b][j]) << l.dump();
         }
     }
   }
-  std::printf("batch kills: %d runs killed, %d finished first, %d done lines checked\n", killed, finished,
-              done_lines_checked);
-  EXPECT_GE(killed, 6);  // the fresh and forced runs are killed before their end but by chance
+  std::printf("batch kills: %d runs killed, %d finished first, %d done lines and %d current outputs checked\n",
+              killed, finished, done_lines_checked, current_checked);
+  EXPECT_GE(killed, 9);  // most runs have work left after k lines: the fresh, changed and forced ones
 
-  const CliRun last = run_cli("-q batch '" + (dir / "run" / "jobs.jsonl").string() + "'", dir);
+  const CliRun last = run_cli("-q batch '" + (dir / "run" / "A.jsonl").string() + "'", dir);
   EXPECT_EQ(last.exit_code, 2) << last.err;
   const auto got = lines(last.out), want = lines(ref.out);
   ASSERT_EQ(got.size(), want.size());
@@ -489,10 +518,10 @@ TEST_F(Batch, KilledAtAnyMomentThenResumedEndsAsOneRun) {
     }
     return without_times(l);
   };
-  for (std::size_t k = 0; k < got.size(); ++k) {
-    EXPECT_EQ(relative(got[k], "run"), relative(want[k], "ref"));
-    EXPECT_EQ(got[k]["status"] == "failed", want[k]["status"] == "failed") << got[k].dump();
-    EXPECT_EQ(files_of(plan.jobs[k]), expected[k]) << plan.jobs[k].output;
+  for (std::size_t j = 0; j < got.size(); ++j) {
+    EXPECT_EQ(relative(got[j], "run"), relative(want[j], "refA"));
+    EXPECT_EQ(got[j]["status"] == "failed", want[j]["status"] == "failed") << got[j].dump();
+    EXPECT_EQ(files_of(plans[0].jobs[j]), expected[0][j]) << plans[0].jobs[j].output;
   }
   EXPECT_TRUE(temporaries_under(dir / "run").empty()) << temporaries_under(dir / "run").front();
 }
