@@ -54,7 +54,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
                   "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
                   "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT or $JOB_COMPLETION_INDEX/N")
       ->capture_default_str();
-  sub->add_flag("--force", opt->force, "Redo assets whose outputs are newer than their inputs");
+  sub->add_flag("--force", opt->force, "Redo assets whose outputs are current (recorded by an earlier run, input and options unchanged)");
   return {sub, [opt, ratio, faces, levels, count, &global]() -> int {
             unsigned shard = 0, shards = 1;
             if (!parse_shard(opt->shard, shard, shards)) {

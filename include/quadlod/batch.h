@@ -1,6 +1,7 @@
 // quadlod — batch runs over many assets (issue 21; docs/batch.md): a folder or a JSON-lines
 // manifest becomes a list of jobs, a deterministic shard of it is run, each job is skipped when
-// its output is newer than its input (resumable), and each job reports one JSON object.
+// the record of an earlier run still vouches for its outputs (resumable after a kill at any
+// moment, issue 36), and each job reports one JSON object.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -52,9 +53,27 @@ std::vector<BatchJob> shard_jobs(const std::vector<BatchJob>& jobs, unsigned ind
 /// Parses "I/N" (0 <= I < N); false when malformed.
 bool parse_shard(const std::string& text, unsigned& index, unsigned& count);
 
-/// True when the job's output (a LOD chain: its lods.json, written last) exists and is not older
-/// than its input: the job was done by an earlier run.
+/// Where run_batch_job records a finished job (issue 36): a dot-named JSON file beside the
+/// output, `DIR/.NAME.batch.json` for the output `DIR/NAME` (a file, or a LOD chain's directory).
+/// Written atomically after every output file, it holds the job's options, the input's size and
+/// modification time (ns), the size and modification time of every file the job wrote (a chain:
+/// each level and lods.json) and the job's result (its line without status and seconds).
+std::filesystem::path batch_record_path(const BatchJob& job);
+
+/// True when the job was done by an earlier run and nothing changed since: its record exists and
+/// names the same options (all but "threads", which does not change the output), the input has
+/// the recorded size and modification time, and every recorded output file has its recorded size
+/// and modification time. So an output without its record (a run killed between the output's
+/// rename and the record's), an output replaced or edited afterwards, a LOD chain rewritten in
+/// part, an input replaced (even by an older file) or changed options all make it false.
 bool batch_output_is_current(const BatchJob& job);
+
+/// Removes the temporary files a killed write left beside the job's outputs (SIGKILL cannot be
+/// caught: write_file_atomically leaves `.NAME.tmp-PID-HEX`): those of the output and of the
+/// record in the output's directory and, for a LOD chain, every one in the chain's directory.
+/// Other jobs' temporaries in a shared directory are left alone. Returns how many were removed.
+/// Two runs must not write the same job's output at once (shards are disjoint).
+std::size_t remove_batch_temporaries(const BatchJob& job);
 
 struct BatchRunParams {
   bool force = false;     ///< run even when the output is current
@@ -64,6 +83,11 @@ struct BatchRunParams {
 /// Runs one job and returns its line: {"input", "output", "status": "done" | "skipped" |
 /// "failed", "error" (failed), "seconds", and the metrics: input/target/achieved
 /// triangle-equivalents, quads, triangles, ngons (a LOD chain: per level)}. Never throws.
+/// Resumable after a kill at any moment (issue 36): the job first removes its leftover
+/// temporaries; a job whose output is current (batch_output_is_current) is "skipped" and its line
+/// carries the recorded metrics, so a resumed run's lines equal an uninterrupted run's but for
+/// status and seconds; otherwise the old record is removed before anything is written, the
+/// outputs are written (atomically), then the new record, then the line says "done".
 nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params);
 
 }  // namespace quadlod

@@ -1,13 +1,28 @@
 // quadlod — batch runs (include/quadlod/batch.h; docs/batch.md).
+//
+// Resuming after a kill at any moment (issue 36). A job's state on disk moves through
+//
+//   (old outputs, old record) ─► remove old record ─► write outputs, each temp + rename ─►
+//   write new record (temp + rename) ─► print the line
+//
+// and a run may die between any two steps, or inside a write (SIGKILL leaves the temp file).
+// The record vouches for exactly the bytes it saw (size + mtime of the input and of every
+// output), so whatever step a run died at, the next run either finds a record that still matches
+// (the job was complete: skip, and repeat the recorded metrics) or redoes the job; and it first
+// removes the job's leftover temp files, so none survives a completed rerun.
 #include "quadlod/batch.h"
+#include "quadlod/io.h"
 #include "quadlod/lod.h"
 #include "quadlod/scene.h"
 
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cstdint>
 #include <fstream>
 #include <set>
+#include <sstream>
+#include <sys/stat.h>
 
 namespace quadlod {
 
@@ -62,6 +77,109 @@ std::filesystem::path resolve(const std::filesystem::path& base, const std::stri
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+namespace fs = std::filesystem;
+
+constexpr int kRecordVersion = 1;
+
+/// The output path without trailing separators ("out/a/" → "out/a"), so that it has a filename.
+fs::path output_path(const BatchJob& job) {
+  fs::path out = job.output;
+  while (!out.has_filename() && out.has_parent_path() && out != out.parent_path()) out = out.parent_path();
+  return out;
+}
+
+/// The directory the record's file names are relative to: a chain's own directory, else the
+/// output's directory.
+fs::path files_base(const BatchJob& job) {
+  const fs::path out = output_path(job);
+  if (is_lod(job.options)) return out;
+  return out.parent_path().empty() ? fs::path(".") : out.parent_path();
+}
+
+/// {"size", "mtime_ns"} of a regular file (mtime in ns since the Unix epoch, as stat(2) and
+/// Python's os.stat give it: std::filesystem's file clock has another epoch); null when it is
+/// missing or not a regular file.
+nlohmann::json file_stamp(const fs::path& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return nullptr;
+  const std::int64_t ns = std::int64_t{st.st_mtim.tv_sec} * 1000000000 + st.st_mtim.tv_nsec;
+  return {{"size", static_cast<std::uint64_t>(st.st_size)}, {"mtime_ns", ns}};
+}
+
+/// The options the record compares: all but "threads" (the output does not depend on it).
+nlohmann::json recorded_options(const nlohmann::json& options) {
+  nlohmann::json kept = options.is_object() ? options : nlohmann::json::object();
+  kept.erase("threads");
+  return kept;
+}
+
+/// The record of an earlier run when it still vouches for the outputs (see
+/// batch_output_is_current), else null.
+nlohmann::json current_record(const BatchJob& job) {
+  std::ifstream in(batch_record_path(job), std::ios::binary);
+  if (!in) return nullptr;
+  std::stringstream text;
+  text << in.rdbuf();
+  const nlohmann::json record = nlohmann::json::parse(text.str(), nullptr, false);
+  if (record.is_discarded() || !record.is_object() || record.value("quadlod_batch_record", 0) != kRecordVersion)
+    return nullptr;
+  if (!record.contains("options") || record["options"] != recorded_options(job.options)) return nullptr;
+  const nlohmann::json input = file_stamp(job.input);
+  if (input.is_null() || !record.contains("input") || record["input"] != input) return nullptr;
+  if (!record.contains("files") || !record["files"].is_array() || record["files"].empty()) return nullptr;
+  if (!record.contains("result") || !record["result"].is_object()) return nullptr;
+  const fs::path base = files_base(job);
+  for (const nlohmann::json& file : record["files"]) {
+    if (!file.is_object() || !file.contains("name") || !file["name"].is_string()) return nullptr;
+    const std::string name = file["name"].get<std::string>();
+    // Names are plain file names in `base`: a record cannot vouch for files elsewhere.
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos) return nullptr;
+    nlohmann::json seen = file_stamp(base / name);
+    if (seen.is_null()) return nullptr;
+    seen["name"] = name;
+    if (seen != file) return nullptr;
+  }
+  return record;
+}
+
+/// True for `.NAME.tmp-PID-HEX`, as write_file_atomically names the temporary of NAME, with
+/// NAME = `target` (any NAME when `target` is empty).
+bool is_temporary_of(const std::string& name, const std::string& target) {
+  if (name.size() < 2 || name[0] != '.') return false;
+  const std::size_t mark = name.rfind(".tmp-");
+  if (mark == std::string::npos || mark < 2) return false;
+  if (!target.empty() && name.compare(1, mark - 1, target) != 0) return false;
+  if (!target.empty() && mark - 1 != target.size()) return false;
+  const std::string tail = name.substr(mark + 5);  // PID-HEX
+  const std::size_t dash = tail.find('-');
+  if (dash == std::string::npos || dash == 0 || dash + 1 == tail.size()) return false;
+  for (std::size_t i = 0; i < tail.size(); ++i) {
+    const char c = tail[i];
+    const bool ok = i < dash ? (c >= '0' && c <= '9') : i == dash || (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+    if (!ok) return false;
+  }
+  return true;
+}
+
+/// Removes the entries of `dir` that are temporaries of one of `targets` (any, when `targets`
+/// holds ""). Returns how many.
+std::size_t remove_temporaries_in(const fs::path& dir, const std::vector<std::string>& targets) {
+  std::size_t removed = 0;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return 0;
+  std::vector<fs::path> doomed;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    for (const std::string& target : targets)
+      if (is_temporary_of(name, target)) {
+        doomed.push_back(entry.path());
+        break;
+      }
+  }
+  for (const fs::path& p : doomed) removed += fs::remove(p, ec) ? 1 : 0;
+  return removed;
 }
 
 }  // namespace
@@ -154,14 +272,22 @@ bool parse_shard(const std::string& text, unsigned& index, unsigned& count) {
          count > 0 && index < count;
 }
 
-bool batch_output_is_current(const BatchJob& job) {
-  std::error_code ec;
-  const std::filesystem::path done = is_lod(job.options) ? job.output / "lods.json" : job.output;
-  if (!std::filesystem::is_regular_file(done, ec)) return false;
-  const auto out_time = std::filesystem::last_write_time(done, ec);
-  if (ec) return false;
-  const auto in_time = std::filesystem::last_write_time(job.input, ec);
-  return !ec && out_time >= in_time;
+std::filesystem::path batch_record_path(const BatchJob& job) {
+  const fs::path out = output_path(job);
+  std::string name(1, '.');  // not "." + string: GCC 12 warns of a bogus overflow (-Wstringop-overflow)
+  name += out.filename().string();
+  name += ".batch.json";
+  return out.parent_path() / name;
+}
+
+bool batch_output_is_current(const BatchJob& job) { return !current_record(job).is_null(); }
+
+std::size_t remove_batch_temporaries(const BatchJob& job) {
+  const fs::path out = output_path(job);
+  const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  std::size_t removed = remove_temporaries_in(dir, {out.filename().string(), batch_record_path(job).filename().string()});
+  if (is_lod(job.options)) removed += remove_temporaries_in(out, {""});  // the chain's own directory
+  return removed;
 }
 
 nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) {
@@ -183,14 +309,32 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
     if (!bad.empty()) return failed(job.input.string() + ": " + bad);
     std::error_code ec;
     if (std::filesystem::equivalent(job.input, job.output, ec)) return failed(job.output.string() + ": refusing to overwrite the input");
-    if (!params.force && batch_output_is_current(job)) {
-      line["status"] = "skipped";
-      line["seconds"] = seconds_since(start);
-      return line;
+    // A temp file of an earlier run killed by SIGKILL (nothing else leaves one): whatever this
+    // run does with the job, it must not survive it.
+    remove_batch_temporaries(job);
+    if (!params.force) {
+      const nlohmann::json record = current_record(job);
+      if (!record.is_null()) {
+        for (const auto& [key, value] : record["result"].items()) line[key] = value;
+        line["status"] = "skipped";
+        line["seconds"] = seconds_since(start);
+        return line;
+      }
     }
+    // From here on the old outputs are being replaced: nothing may vouch for them any more
+    // (a chain killed after its first level would otherwise keep the old lods.json's word).
+    const fs::path record_path = batch_record_path(job);
+    fs::remove(record_path, ec);
+    if (fs::exists(fs::symlink_status(record_path, ec))) return failed(record_path.string() + ": cannot remove the old record");
+
+    // The input's stamp before it is read and again after the work (below): an input changed
+    // meanwhile gets no record.
+    const nlohmann::json input_stamp = file_stamp(job.input);
     const SceneReadResult in = read_scene(job.input);
     if (!in.ok()) return failed(in.error);
     if (in.scene.meshes.empty()) return failed(job.input.string() + ": the scene has no mesh to reduce");
+    nlohmann::json result = nlohmann::json::object();
+    std::vector<std::string> written_files;
     if (is_lod(job.options)) {
       LodChainParams chain_params;
       chain_params.ratios = levels;
@@ -201,13 +345,15 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
       const LodFilesResult files =
           write_lod_files(chain, job.input, job.output, ext, {{"input", job.input.string()}});
       if (!files.ok()) return failed(files.error);
-      line["input_tri_equivalent"] = files.report["input_tri_equivalent"];
-      line["levels"] = nlohmann::json::array();
+      result["input_tri_equivalent"] = files.report["input_tri_equivalent"];
+      result["levels"] = nlohmann::json::array();
       for (const auto& level : files.report["levels"]) {
         nlohmann::json l = level;
         l.erase("meshes");
-        line["levels"].push_back(std::move(l));
+        if (l.contains("file") && l["file"].is_string()) written_files.push_back(l["file"].get<std::string>());
+        result["levels"].push_back(std::move(l));
       }
+      written_files.push_back("lods.json");  // written last by write_lod_files
     } else {
       SceneSimplifyParams scene_params;
       scene_params.options = simplify;
@@ -220,14 +366,36 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
       std::filesystem::create_directories(job.output.parent_path().empty() ? "." : job.output.parent_path(), ec);
       const WriteResult written = write_scene(r.scene, job.output);
       if (!written.ok()) return failed(written.error);
-      line["input_tri_equivalent"] = r.input_tri_equivalent;
-      line["target"] = r.target;
-      line["achieved"] = r.achieved;
-      line["quads"] = r.quads;
-      line["triangles"] = r.triangles;
-      line["ngons"] = r.ngons;
-      line["meshes"] = r.scene.meshes.size();
+      result["input_tri_equivalent"] = r.input_tri_equivalent;
+      result["target"] = r.target;
+      result["achieved"] = r.achieved;
+      result["quads"] = r.quads;
+      result["triangles"] = r.triangles;
+      result["ngons"] = r.ngons;
+      result["meshes"] = r.scene.meshes.size();
+      written_files.push_back(output_path(job).filename().string());
     }
+
+    // The record, last: the stamps of what was just written, and of the input as it was read.
+    // An input changed during the run gets no record: the line says done (this run's outputs
+    // are complete) and the next run redoes the job.
+    nlohmann::json record = {{"quadlod_batch_record", kRecordVersion},
+                             {"options", recorded_options(job.options)},
+                             {"input", input_stamp},
+                             {"files", nlohmann::json::array()},
+                             {"result", result}};
+    const fs::path base = files_base(job);
+    for (const std::string& name : written_files) {
+      nlohmann::json stamp = file_stamp(base / name);
+      if (stamp.is_null()) return failed((base / name).string() + ": missing right after it was written");
+      stamp["name"] = name;
+      record["files"].push_back(std::move(stamp));
+    }
+    if (!input_stamp.is_null() && file_stamp(job.input) == input_stamp) {
+      const WriteResult saved = write_file_atomically(record_path, record.dump() + "\n");
+      if (!saved.ok()) return failed(saved.error);
+    }
+    for (const auto& [key, value] : result.items()) line[key] = value;
     line["status"] = "done";
     line["seconds"] = seconds_since(start);
     return line;
