@@ -901,9 +901,36 @@ TEST(ClusterCollapseFeatures, FeatureCornerDoesNotMove) {
   for (Index j = 1; j < m; ++j) EXPECT_NEAR(r.mesh.positions[r.vertex_map[id(0, j)]].x(), 0.0, 1e-12);
 }
 
+// The ring of edges parallel to x between the layers x = -1/6 and x = 1/6 of make_cube(3, 1).
+std::vector<std::uint8_t> cube_with_middle_ring_collapsed(const PolyMesh& in, const Connectivity& conn) {
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    const auto [a, b] = conn.edge_vertices[e];
+    const Vec3 &pa = in.positions[a], &pb = in.positions[b];
+    if (std::abs(std::abs(pa.x() - pb.x()) - 1.0 / 3) < 1e-12 && std::abs(pa.x() + pb.x()) < 1e-12) kept[e] = 0;
+  }
+  return kept;
+}
+
+// Custom normals travel (issue 32: normals interpolated, not recomputed): a cube whose every
+// corner normal points up, as foliage is shaded, keeps every output normal up after a ring of
+// its vertices merged — the recomputed normals would be the faces' (5 of 6 sides not up).
+TEST(ClusterCollapseFeatures, CustomNormalsAreCarriedNotRecomputed) {
+  PolyMesh in = make_cube(3, 1.0);
+  in.normals.assign(1, Vec3(0, 0, 1));
+  in.corner_normal.assign(in.num_corners(), 0);
+  const Connectivity conn = build_connectivity(in);
+  const ClusterCollapseResult r = collapse_clusters(in, conn, cube_with_middle_ring_collapsed(in, conn));
+  expect_valid_output(in, r);
+  EXPECT_EQ(r.stats.total_refusals(), 0u);
+  EXPECT_GT(r.stats.normals_recomputed, 0u);
+  for (Index c = 0; c < r.mesh.num_corners(); ++c)
+    EXPECT_LT((r.mesh.normals[r.mesh.corner_normal[c]] - Vec3(0, 0, 1)).norm(), 1e-12) << "corner " << c;
+}
+
 // A 3×3×3 cube with one normal per side (hard edges): after collapsing a ring chord, every
-// corner normal is its output face's normal — recomputed per side, the 90° edges stay hard.
-TEST(ClusterCollapseFeatures, NormalsAreRecomputedPerSideAndStayHard) {
+// corner normal is its output face's normal — a new value per side, the 90° edges stay hard.
+TEST(ClusterCollapseFeatures, NormalsAreNewPerSideAndStayHard) {
   PolyMesh in = make_cube(3, 1.0);
   in.normals.clear();
   in.corner_normal.assign(in.num_corners(), kInvalidIndex);

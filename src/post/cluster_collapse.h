@@ -258,7 +258,7 @@ struct ClusterCollapseStats {
   Index line_crossings = 0;
   // Attributes.
   Index uv_values_projected = 0;    ///< new UV values (wedges of moved vertices, all sets)
-  Index normals_recomputed = 0;     ///< new normal values (wedges of moved vertices)
+  Index normals_recomputed = 0;     ///< new normal values (wedges of moved vertices), projected or recomputed
   // Refinement.
   Index rounds = 0;                ///< check rounds run (1 when nothing was refused)
   Index clusters_bisected = 0;

@@ -279,7 +279,31 @@ void Collapser::project_attributes(PolyMesh& om, std::vector<std::vector<Index>>
     }
     if (normals) {
       label_sectors(same_normal);
+      // Projected like the UVs: the barycentric mix of the input normals at the closest point of
+      // the sector's input faces, so that custom normals (foliage pointing up, weighted normals)
+      // travel and each side of a line keeps its own, interpolated along it (issue 32). Where
+      // that mix has no direction (opposite normals, corners without one), the normal follows
+      // the output faces of the sector.
       assign(normal_override, [&](Index s) -> Index {
+        const Nearest* best = nullptr;
+        for (Index i = 0; i < ns; ++i) {
+          if (sector[i] != s) continue;
+          const Nearest& n = nearest[i];
+          if (n.c0 == kInvalidIndex || mesh_.corner_normal[n.c0] == kInvalidIndex ||
+              mesh_.corner_normal[n.c1] == kInvalidIndex || mesh_.corner_normal[n.c2] == kInvalidIndex)
+            continue;
+          if (!best || n.d2 < best->d2) best = &n;
+        }
+        if (best) {
+          const Vec3 mix = best->w[0] * mesh_.normals[mesh_.corner_normal[best->c0]] +
+                           best->w[1] * mesh_.normals[mesh_.corner_normal[best->c1]] +
+                           best->w[2] * mesh_.normals[mesh_.corner_normal[best->c2]];
+          const double len = mix.norm();
+          if (len > 1e-6 && std::isfinite(len)) {
+            mine.normals.push_back(mix / len);
+            return static_cast<Index>(mine.normals.size() - 1);
+          }
+        }
         Vec3 sum = Vec3::Zero();
         for (Index i = 0; i < ns; ++i) {
           if (sector[i] != s) continue;
