@@ -521,6 +521,7 @@ TEST(EvalMetrics, JsonHasEveryMetric) {
                         "qpr", "qpr_rule", "quad_fraction_in", "quad_fraction_out", "pccd", "pccd_defined",
                         "flow_deviation_deg", "flow_deviation_p90_deg", "flow_coverage",
                         "tri_equivalent_in", "tri_equivalent_out", "quads_in", "tris_out", "ngons_out",
+                        "uv_stretch_in", "uv_stretch_out", "uv_stretch_skipped_out",
                         "scale", "seed", "samples_in", "seconds"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["ngons_in"], 1);
@@ -691,6 +692,27 @@ void expect_islands(const EvalResult& r, std::uint64_t in, std::uint64_t out, st
 
 // Island correspondence (uv_islands_vanished / _merged / _split) on known cases: a 6×2 grid
 // whose column pairs are three islands A | B | C (UV shifts 0, 3, 6).
+// Sander et al.'s L2 stretch, normalised (issue 32's "report the UV stretch"): make_grid's UVs are
+// the unit lattice, so a square grid of any size is a map without stretch (1), and a 1 × 2 grid
+// has S_s = (1, 0, 0), S_t = (0, 2, 0): √((1 + 4) / 2) · √(UV area 1 / area 2) = √1.25.
+TEST(EvalFeatures, UvStretchKnownAnswers) {
+  const PolyMesh square = make_grid(4, 4, 3.0, 3.0), tall = make_grid(4, 4, 1.0, 2.0);
+  const EvalResult r = evaluate(square, tall, small_params());
+  EXPECT_NEAR(r.uv_stretch_in, 1.0, 1e-12);
+  EXPECT_NEAR(r.uv_stretch_out, std::sqrt(1.25), 1e-12);
+  EXPECT_EQ(r.uv_stretch_skipped_out, 0u);
+  // A face whose UVs collapse to a point has no UV area: left out and counted (2 fan triangles).
+  PolyMesh pinched = square;
+  for (Index c = pinched.face_begin(0); c < pinched.face_end(0); ++c)
+    pinched.uv_sets[0].corner[c] = pinched.uv_sets[0].corner[pinched.face_begin(0)];
+  const EvalResult q = evaluate(square, pinched, small_params());
+  EXPECT_NEAR(q.uv_stretch_out, 1.0, 1e-12);
+  EXPECT_EQ(q.uv_stretch_skipped_out, 2u);
+  PolyMesh bare = square;
+  bare.uv_sets.clear();
+  EXPECT_TRUE(std::isnan(evaluate(square, bare, small_params()).uv_stretch_out));
+}
+
 TEST(EvalFeatures, IslandsVanishMergeAndSplitKnownAnswers) {
   const Index n = 6, m = 2;
   const PolyMesh in = grid_with_column_islands(n, m, {0, 0, 3, 3, 6, 6});

@@ -601,6 +601,56 @@ UvErrorResult uv_error(const PolyMesh& input, const PolyMesh& output, const Poly
   return r;
 }
 
+struct UvStretch {
+  double l2 = kNaN;           ///< normalised L2 stretch, 1 = no distortion
+  std::uint64_t skipped = 0;  ///< fan triangles without UVs or without UV area
+};
+
+/// Sander, Snyder, Gortler, Hoppe 2001 ("Texture mapping progressive meshes"), §3: per triangle
+/// the Jacobian of UV → surface, S_s and S_t, and L2 = √((|S_s|² + |S_t|²) / 2); over the mesh
+/// √(Σ L2² A / Σ A) with A the surface area, times √(Σ A_uv / Σ A) so that the map's scale drops
+/// out. Fan triangles of each face, the mesh's first UV set.
+UvStretch uv_stretch(const PolyMesh& m) {
+  UvStretch r;
+  if (m.uv_sets.empty()) return r;
+  const UvSet& set = m.uv_sets[0];
+  double sum_l2 = 0.0, sum_area = 0.0, sum_uv_area = 0.0;
+  for (Index f = 0; f < m.num_faces(); ++f) {
+    const Index b = m.face_begin(f), k = m.face_size(f);
+    for (Index j = 1; j + 1 < k; ++j) {
+      const Index c[3] = {b, b + j, b + j + 1};
+      if (set.corner[c[0]] == kInvalidIndex || set.corner[c[1]] == kInvalidIndex || set.corner[c[2]] == kInvalidIndex) {
+        ++r.skipped;
+        continue;
+      }
+      const Vec3& q1 = m.positions[m.corner_vertex[c[0]]];
+      const Vec3& q2 = m.positions[m.corner_vertex[c[1]]];
+      const Vec3& q3 = m.positions[m.corner_vertex[c[2]]];
+      const Vec2& u1 = set.values[set.corner[c[0]]];
+      const Vec2& u2 = set.values[set.corner[c[1]]];
+      const Vec2& u3 = set.values[set.corner[c[2]]];
+      const double uv_area2 = (u2.x() - u1.x()) * (u3.y() - u1.y()) - (u3.x() - u1.x()) * (u2.y() - u1.y());
+      const double area = 0.5 * (q2 - q1).cross(q3 - q1).norm();
+      if (!(std::abs(uv_area2) > 0.0) || !std::isfinite(uv_area2)) {
+        ++r.skipped;
+        continue;
+      }
+      const Vec3 ss = (q1 * (u2.y() - u3.y()) + q2 * (u3.y() - u1.y()) + q3 * (u1.y() - u2.y())) / uv_area2;
+      const Vec3 st = (q1 * (u3.x() - u2.x()) + q2 * (u1.x() - u3.x()) + q3 * (u2.x() - u1.x())) / uv_area2;
+      const double l2_sq = 0.5 * (ss.squaredNorm() + st.squaredNorm());
+      if (!std::isfinite(l2_sq)) {
+        ++r.skipped;
+        continue;
+      }
+      sum_l2 += l2_sq * area;
+      sum_area += area;
+      sum_uv_area += 0.5 * std::abs(uv_area2);
+    }
+  }
+  if (sum_area > 0.0) r.l2 = std::sqrt(sum_l2 / sum_area) * std::sqrt(sum_uv_area / sum_area);
+  return r;
+}
+
 }  // namespace
 
 /// §6c: every metric of the features section, on the scaled copies (in, out) for geometry and the
@@ -637,6 +687,13 @@ void feature_metrics(const PolyMesh& input, const PolyMesh& output, const PolyMe
     r.uv_islands_vanished = m.vanished;
     r.uv_islands_merged = m.merged;
     r.uv_islands_split = m.split;
+  }
+  r.uv_stretch_in = r.uv_stretch_out = kNaN;
+  if (input.has_uvs() && output.has_uvs()) {
+    const UvStretch sin = uv_stretch(input), sout = uv_stretch(output);
+    r.uv_stretch_in = sin.l2;
+    r.uv_stretch_out = sout.l2;
+    r.uv_stretch_skipped_out = sout.skipped;
   }
 
   // Material borders, keyed by the unordered pair of names.
