@@ -521,7 +521,8 @@ TEST(EvalMetrics, JsonHasEveryMetric) {
                         "qpr", "qpr_rule", "quad_fraction_in", "quad_fraction_out", "pccd", "pccd_defined",
                         "flow_deviation_deg", "flow_deviation_p90_deg", "flow_coverage",
                         "tri_equivalent_in", "tri_equivalent_out", "quads_in", "tris_out", "ngons_out",
-                        "uv_stretch_in", "uv_stretch_out", "uv_stretch_skipped_out",
+                        "uv_stretch_median_in", "uv_stretch_median_out", "uv_stretch_p90_in", "uv_stretch_p90_out",
+                        "uv_stretch_skipped_out",
                         "scale", "seed", "samples_in", "seconds"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["ngons_in"], 1);
@@ -698,19 +699,22 @@ void expect_islands(const EvalResult& r, std::uint64_t in, std::uint64_t out, st
 TEST(EvalFeatures, UvStretchKnownAnswers) {
   const PolyMesh square = make_grid(4, 4, 3.0, 3.0), tall = make_grid(4, 4, 1.0, 2.0);
   const EvalResult r = evaluate(square, tall, small_params());
-  EXPECT_NEAR(r.uv_stretch_in, 1.0, 1e-12);
-  EXPECT_NEAR(r.uv_stretch_out, std::sqrt(1.25), 1e-12);
+  EXPECT_NEAR(r.uv_stretch_median_in, 1.0, 1e-12);
+  EXPECT_NEAR(r.uv_stretch_p90_in, 1.0, 1e-12);
+  EXPECT_NEAR(r.uv_stretch_median_out, std::sqrt(1.25), 1e-12);
+  EXPECT_NEAR(r.uv_stretch_p90_out, std::sqrt(1.25), 1e-12);
   EXPECT_EQ(r.uv_stretch_skipped_out, 0u);
   // A face whose UVs collapse to a point has no UV area: left out and counted (2 fan triangles).
   PolyMesh pinched = square;
   for (Index c = pinched.face_begin(0); c < pinched.face_end(0); ++c)
     pinched.uv_sets[0].corner[c] = pinched.uv_sets[0].corner[pinched.face_begin(0)];
   const EvalResult q = evaluate(square, pinched, small_params());
-  EXPECT_NEAR(q.uv_stretch_out, 1.0, 1e-12);
+  EXPECT_NEAR(q.uv_stretch_median_out, 1.0, 1e-12);
+  EXPECT_NEAR(q.uv_stretch_p90_out, 1.0, 1e-12);
   EXPECT_EQ(q.uv_stretch_skipped_out, 2u);
   PolyMesh bare = square;
   bare.uv_sets.clear();
-  EXPECT_TRUE(std::isnan(evaluate(square, bare, small_params()).uv_stretch_out));
+  EXPECT_TRUE(std::isnan(evaluate(square, bare, small_params()).uv_stretch_median_out));
 }
 
 TEST(EvalFeatures, IslandsVanishMergeAndSplitKnownAnswers) {

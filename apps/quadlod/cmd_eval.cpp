@@ -182,7 +182,9 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
                         (unsigned long long)r.uv_islands_vanished, (unsigned long long)r.uv_islands_merged,
                         (unsigned long long)r.uv_islands_split,
                         (unsigned long long)r.seams_torn, num(r.uv_error_mean), num(r.uv_error_max));
-            std::printf("  uv stretch          %.4f -> %.4f (L2, 1 = none)\n", num(r.uv_stretch_in), num(r.uv_stretch_out));
+            std::printf("  uv stretch          median %.4f -> %.4f, p90 %.4f -> %.4f (L2, 1 = none)\n",
+                        num(r.uv_stretch_median_in), num(r.uv_stretch_median_out), num(r.uv_stretch_p90_in),
+                        num(r.uv_stretch_p90_out));
             if (std::isnan(r.material_mismatch_fraction))
               std::printf("  materials           none in either mesh\n");
             else

@@ -155,12 +155,13 @@ struct EvalResult {
   double uv_error_max = 0.0;
   std::uint64_t uv_samples = 0;  ///< output samples that entered uv_error
   /// UV stretch of each mesh's first UV set (issue 32): Sander et al. 2001's L2 stretch of the
-  /// map from UV to surface, area-weighted over the fan triangles, times √(UV area / surface
-  /// area) so that 1 is a map without distortion at any uniform scale and more is stretch or
-  /// shear. uv_stretch_out / uv_stretch_in is what a reduction added. Triangles without UVs or
-  /// with no UV area are left out (counted in uv_stretch_skipped_out). NaN without UVs.
-  double uv_stretch_in = 0.0;
-  double uv_stretch_out = 0.0;
+  /// map from UV to surface per fan triangle, times √(UV area / surface area) so that 1 is a map
+  /// without distortion at any uniform scale and more is stretch or shear; its area-weighted
+  /// median and 90th percentile over the surface (their mean is ruled by slivers of UV).
+  /// Triangles without UVs or with no UV area are left out (uv_stretch_skipped_out counts the
+  /// output's). NaN without UVs.
+  double uv_stretch_median_in = 0.0, uv_stretch_median_out = 0.0;
+  double uv_stretch_p90_in = 0.0, uv_stretch_p90_out = 0.0;
   std::uint64_t uv_stretch_skipped_out = 0;
   /// Distance (normalised units) from the sample points of output material-border edges to the
   /// nearest input border between the same two materials (by name): max and length-weighted mean.

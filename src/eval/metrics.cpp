@@ -286,7 +286,7 @@ EvalResult evaluate(const PolyMesh& input, const PolyMesh& output, const EvalPar
     r.pccd = r.pccd_in_to_out = r.pccd_out_to_in = kNaN;
     r.flow_deviation_deg = r.flow_deviation_p90_deg = r.flow_coverage = kNaN;
     r.uv_error_mean = r.uv_error_max = r.material_border_error = r.material_border_error_mean = kNaN;
-    r.uv_stretch_in = r.uv_stretch_out = kNaN;
+    r.uv_stretch_median_in = r.uv_stretch_median_out = r.uv_stretch_p90_in = r.uv_stretch_p90_out = kNaN;
     r.material_mismatch_fraction = r.feature_deviation_max = r.feature_deviation_mean = kNaN;
     r.seconds = seconds_since(t0);
     return r;
@@ -571,8 +571,10 @@ nlohmann::json to_json(const EvalResult& r) {
   j["uv_error_mean"] = num(r.uv_error_mean);
   j["uv_error_max"] = num(r.uv_error_max);
   j["uv_samples"] = r.uv_samples;
-  j["uv_stretch_in"] = num(r.uv_stretch_in);
-  j["uv_stretch_out"] = num(r.uv_stretch_out);
+  j["uv_stretch_median_in"] = num(r.uv_stretch_median_in);
+  j["uv_stretch_median_out"] = num(r.uv_stretch_median_out);
+  j["uv_stretch_p90_in"] = num(r.uv_stretch_p90_in);
+  j["uv_stretch_p90_out"] = num(r.uv_stretch_p90_out);
   j["uv_stretch_skipped_out"] = r.uv_stretch_skipped_out;
   j["material_border_error"] = num(r.material_border_error);
   j["material_border_error_mean"] = num(r.material_border_error_mean);
