@@ -120,7 +120,7 @@ PipelineCase decode_pipeline_case(std::string_view bytes) {
   const std::uint8_t flags = in.u8();
   o.features = !(flags & 1);
   if (flags & 2) {
-    o.objective = "paper";
+    o.objective = SimplifyOptions::Objective::Paper;
     o.time_limit_seconds = 0.0;  // greedy selection: a MIP has no place in a 2 s budget
   }
   o.segmentation = !(flags & 4);

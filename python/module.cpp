@@ -33,9 +33,27 @@ OptionSetter set_field(T SimplifyOptions::*field) {
   return [field](SimplifyOptions& o, const py::handle& v) { o.*field = v.cast<T>(); };
 }
 
+/// A choice (an enum of SimplifyOptions) by one of its names (include/quadlod/simplify.h); any
+/// other name is a ValueError listing them: "objective: 'shape' or 'paper', not 'bogus'".
+template <class E>
+OptionSetter set_choice(E SimplifyOptions::*field, const char* key, std::vector<std::pair<std::string, E>> names) {
+  return [field, key, names = std::move(names)](SimplifyOptions& o, const py::handle& v) {
+    const std::string chosen = v.cast<std::string>();
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i].first == chosen) {
+        o.*field = names[i].second;
+        return;
+      }
+      list += (i == 0 ? "'" : i + 1 == names.size() ? " or '" : ", '") + names[i].first + "'";
+    }
+    throw py::value_error(std::string(key) + ": " + list + ", not '" + chosen + "'");
+  };
+}
+
 const std::map<std::string, OptionSetter>& option_table() {
   static const std::map<std::string, OptionSetter> table = {
-      {"objective", set_field(&SimplifyOptions::objective)},
+      {"objective", set_choice(&SimplifyOptions::objective, "objective", objective_names())},
       {"lambda_shape", set_field(&SimplifyOptions::lambda_shape)},
       {"triangle_collapse_factor", set_field(&SimplifyOptions::triangle_collapse_factor)},
       {"max_triangle_share", set_field(&SimplifyOptions::max_triangle_share)},
@@ -52,7 +70,7 @@ const std::map<std::string, OptionSetter>& option_table() {
          if (f != "fast" && f != "exact") throw py::value_error("formulation: 'fast' or 'exact', not '" + f + "'");
          o.exact_formulation = f == "exact";
        }},
-      {"strategy", set_field(&SimplifyOptions::strategy)},
+      {"strategy", set_choice(&SimplifyOptions::strategy, "strategy", selection_strategy_names())},
       {"neighbourhood_groups", set_field(&SimplifyOptions::neighbourhood_groups)},
       {"stall_seconds", set_field(&SimplifyOptions::stall_seconds)},
       {"epsilon_n", set_field(&SimplifyOptions::epsilon_n)},
@@ -69,14 +87,8 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"place_on_hard_edges", set_field(&SimplifyOptions::place_on_hard_edges)},
       {"hard_angle", set_field(&SimplifyOptions::hard_angle_deg)},
       {"surface_fit", set_field(&SimplifyOptions::surface_fit_iterations)},
-      {"recover_quads", set_field(&SimplifyOptions::recover_quads)},
-      {"seams",
-       [](SimplifyOptions& o, const py::handle& v) {
-         const std::string name = v.cast<std::string>();
-         const auto policy = parse_seam_policy(name);
-         if (!policy) throw py::value_error("seams: 'auto' or 'strict', not '" + name + "'");
-         o.seams = *policy;
-       }},
+      {"recover_quads", set_choice(&SimplifyOptions::recover_quads, "recover_quads", quad_recovery_names())},
+      {"seams", set_choice(&SimplifyOptions::seams, "seams", seam_policy_names())},
       {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
       {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},
       {"consistency", set_field(&SimplifyOptions::consistency)},
@@ -105,12 +117,6 @@ void check_ranges(const SimplifyOptions& o) {
   in(o.max_rounds, 1, 64, "max_rounds");
   in(o.surface_fit_iterations, 0, 100, "surface_fit");
   in(o.surface_fit_vertex_weight, 0.0, 100.0, "surface_fit_vertex_weight");
-  if (o.objective != "shape" && o.objective != "paper")
-    throw py::value_error("objective: 'shape' or 'paper', not '" + o.objective + "'");
-  if (o.recover_quads != "auto" && o.recover_quads != "on" && o.recover_quads != "off")
-    throw py::value_error("recover_quads: 'auto', 'on' or 'off', not '" + o.recover_quads + "'");
-  if (o.strategy != "auto" && o.strategy != "whole" && o.strategy != "neighbourhoods")
-    throw py::value_error("strategy: 'auto', 'whole' or 'neighbourhoods', not '" + o.strategy + "'");
 }
 
 SimplifyOptions options_from_kwargs(const py::kwargs& kwargs) {

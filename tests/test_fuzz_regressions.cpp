@@ -65,7 +65,7 @@ TEST(FuzzRegressions, PipelineCaseEncodingRoundTrips) {
   EXPECT_EQ(c.mesh.face_offsets, grid.face_offsets);
   ASSERT_EQ(c.mesh.num_vertices(), grid.num_vertices());
   EXPECT_DOUBLE_EQ(c.options.ratio, 128.0 / 256.0);
-  EXPECT_EQ(c.options.objective, "paper");
+  EXPECT_EQ(c.options.objective, SimplifyOptions::Objective::Paper);
   EXPECT_EQ(c.options.max_passes, 1);
   EXPECT_TRUE(c.options.features);
   // The grid spans 2 × 1: x maps to [-64, 64], y to [-32, 32].

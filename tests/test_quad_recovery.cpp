@@ -168,7 +168,7 @@ TEST(QuadRecovery, SimplifyJoinsAnAllTriangleInputByDefaultAndSaysSo) {
   EXPECT_EQ(joined.report["quad_recovery"]["faces_after"].get<Index>(), torus.num_faces());
   EXPECT_EQ(joined.report["options"]["recover_quads"].get<std::string>(), "auto");
   // The same reduction as of the quad torus itself: its quads were found again exactly.
-  options.recover_quads = "off";
+  options.recover_quads = SimplifyOptions::QuadRecovery::Off;
   const SimplifyResult quads = simplify(torus, options);
   ASSERT_TRUE(quads.ok()) << quads.error;
   EXPECT_EQ(joined.mesh.corner_vertex, quads.mesh.corner_vertex);
@@ -179,10 +179,14 @@ TEST(QuadRecovery, SimplifyJoinsAnAllTriangleInputByDefaultAndSaysSo) {
   EXPECT_FALSE(plain.report.contains("quad_recovery"));
   for (Index f = 0; f < plain.mesh.num_faces(); ++f) EXPECT_EQ(plain.mesh.face_size(f), 3);
   // A mesh with quads is left alone by "auto".
-  options.recover_quads = "auto";
+  options.recover_quads = SimplifyOptions::QuadRecovery::Auto;
   EXPECT_FALSE(simplify(torus, options).report.contains("quad_recovery"));
-  options.recover_quads = "sometimes";
-  EXPECT_EQ(simplify(tris, options).error, "unknown recover_quads 'sometimes' (auto, on, off)");
+  // The names the CLI, manifests and Python take; a value outside the enum is refused.
+  EXPECT_EQ(parse_quad_recovery("on"), SimplifyOptions::QuadRecovery::On);
+  EXPECT_EQ(parse_quad_recovery("sometimes"), std::nullopt);
+  EXPECT_STREQ(to_string(SimplifyOptions::QuadRecovery::Off), "off");
+  options.recover_quads = static_cast<SimplifyOptions::QuadRecovery>(7);
+  EXPECT_EQ(simplify(tris, options).error, "unknown recover_quads 7 (auto, on, off)");
 }
 
 }  // namespace

@@ -217,8 +217,10 @@ TEST(ShapeSelection, PipelineReportsTheShapeObjective) {
   // The shape objective's passes: 0.4 at a pass ratio of 0.9 plans ⌈log 0.4 / log 0.9⌉ = 9.
   EXPECT_EQ(r.report["passes_planned"].get<int>(), 9);
   EXPECT_EQ(r.report["options"]["pass_ratio"].get<double>(), 0.9);
-  options.objective = "bogus";
-  EXPECT_FALSE(simplify(vase, options).ok());
+  EXPECT_EQ(parse_objective("paper"), SimplifyOptions::Objective::Paper);
+  EXPECT_EQ(parse_objective("bogus"), std::nullopt);
+  options.objective = static_cast<SimplifyOptions::Objective>(9);
+  EXPECT_EQ(simplify(vase, options).error, "unknown objective 9 (shape, paper)");
 }
 
 // Issue 20's first requirement for the default objective: the same input and options give the

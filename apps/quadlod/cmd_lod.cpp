@@ -42,13 +42,13 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--format", opt->format, "Output format (default: the input's, .glb for formats quadlod does not write)")
       ->check(CLI::IsMember({"glb", "obj", "fbx", "dae", "ply", "off"}));
   SimplifyOptions& p = opt->chain.simplify;
-  sub->add_option("--objective", p.objective, "shape or paper (as in simplify)")
-      ->check(CLI::IsMember({"shape", "paper"}))->capture_default_str()->group("Reduction");
+  add_choice_option(sub, "--objective", p.objective, objective_names(), "shape or paper (as in simplify)")->group("Reduction");
   sub->add_option("--time-limit", p.time_limit_seconds, "MIP time budget per level in seconds (objective paper)")
       ->check(CLI::Range(0.0, 86400.0))->capture_default_str()->group("Reduction");
   sub->add_option("--threads", p.threads, "Threads (0 = all cores)")->check(CLI::Range(0, 256))->capture_default_str()->group("Reduction");
-  sub->add_option("--recover-quads", p.recover_quads, "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
-      ->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str()->group("Reduction");
+  add_choice_option(sub, "--recover-quads", p.recover_quads, quad_recovery_names(),
+                    "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
+      ->group("Reduction");
   sub->add_option("--seams", p.seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->transform(CLI::CheckedTransformer(seam_policy_names(), CLI::ignore_case))
       ->default_str("auto")

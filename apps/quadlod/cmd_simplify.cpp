@@ -23,7 +23,6 @@ struct SimplifyCliOptions {
   std::uint64_t faces = 0;
   SimplifyOptions pipeline;
   std::string formulation = "fast";
-  std::string strategy = "auto";
   bool no_consistency = false, no_segmentation = false, no_geometry = false, no_dual = false;
   bool no_features = false, no_greedy_fallback = false, decide_on_doubles = false;
   bool per_mesh = false;
@@ -61,9 +60,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                 "Scenes: the target applies to each mesh (default: the scene's target, split by triangle-equivalents)")
       ->group("Target (one of)");
   SimplifyOptions& p = opt->pipeline;
-  sub->add_option("--objective", p.objective,
-                  "shape (the geometric error of the output, deterministic greedy) or paper (Eq. 9 with the MIP search)")
-      ->check(CLI::IsMember({"shape", "paper"}))->capture_default_str()->group("Objective");
+  add_choice_option(sub, "--objective", p.objective, objective_names(),
+                    "shape (the geometric error of the output, deterministic greedy) or paper (Eq. 9 with the MIP search)")
+      ->group("Objective");
   sub->add_option("--lambda-shape", p.lambda_shape, "Weight of the quad-shape term of the shape objective (0 = error only)")
       ->check(CLI::Range(0.0, 1e6))->default_str(std::to_string(default_lambda_shape()))->group("Objective");
   sub->add_option("--triangle-collapse-factor", p.triangle_collapse_factor,
@@ -93,9 +92,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Solver");
   sub->add_option("--formulation", opt->formulation, "fast, or exact (the paper's model as written)")
       ->check(CLI::IsMember({"fast", "exact"}))->capture_default_str()->group("Solver");
-  sub->add_option("--strategy", opt->strategy,
-                  "auto, whole (one MIP) or neighbourhoods (large-neighbourhood search); fast formulation only")
-      ->check(CLI::IsMember({"auto", "whole", "neighbourhoods"}))->capture_default_str()->group("Solver");
+  add_choice_option(sub, "--strategy", p.strategy, selection_strategy_names(),
+                    "auto, whole (one MIP) or neighbourhoods (large-neighbourhood search); fast formulation only")
+      ->group("Solver");
   sub->add_option("--neighbourhood-groups", p.neighbourhood_groups,
                   "Groups freed per neighbourhood MIP (strategy neighbourhoods)")
       ->check(CLI::Range(1, 1000000))->capture_default_str()->group("Solver");
@@ -121,11 +120,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--pass-ratio", p.pass_ratio,
                   "Split reductions below this ratio into passes of equal ratio, each at most this")
       ->check(CLI::Range(0.05, 0.95))
-      ->default_str(std::to_string(default_pass_ratio("shape")) + " (shape), " + std::to_string(default_pass_ratio("paper")) + " (paper)")
+      ->default_str(std::to_string(default_pass_ratio(SimplifyOptions::Objective::Shape)) + " (shape), " +
+                    std::to_string(default_pass_ratio(SimplifyOptions::Objective::Paper)) + " (paper)")
       ->group("Guarantees");
   sub->add_option("--max-passes", p.max_passes, "Most passes (1 = one global selection, as in the paper)")
       ->check(CLI::Range(1, 64))
-      ->default_str(std::to_string(default_max_passes("shape")) + " (shape), " + std::to_string(default_max_passes("paper")) + " (paper)")
+      ->default_str(std::to_string(default_max_passes(SimplifyOptions::Objective::Shape)) + " (shape), " +
+                    std::to_string(default_max_passes(SimplifyOptions::Objective::Paper)) + " (paper)")
       ->group("Guarantees");
   sub->add_flag("--no-greedy-fallback", opt->no_greedy_fallback,
                 "Keep the optimised selection's output even when a greedy selection's run gets closer to the target")
@@ -149,9 +150,9 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--surface-fit", p.surface_fit_iterations,
                   "Steps of the final fit of the output's vertices to the input surface (lower Chamfer; 0 = keep the collapse's placements)")
       ->check(CLI::Range(0, 100))->capture_default_str()->group("Features");
-  sub->add_option("--recover-quads", p.recover_quads,
-                  "Join triangle pairs back into quads before the reduction: auto (when every face is a triangle, as in glTF), on, off")
-      ->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str()->group("Features");
+  add_choice_option(sub, "--recover-quads", p.recover_quads, quad_recovery_names(),
+                    "Join triangle pairs back into quads before the reduction: auto (when every face is a triangle, as in glTF), on, off")
+      ->group("Features");
   sub->add_option("--surface-fit-vertex-weight", p.surface_fit_vertex_weight,
                   "Weight of peak vertices (farther from the input than their faces' samples) in the fit: lower Hausdorff, higher Chamfer (0.25 measured; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->capture_default_str()->group("Features");
@@ -200,7 +201,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
               return kExitUsage;
             }
             // The shape objective has no time budget: a given --time-limit bounds its run.
-            if (time_limit->count() > 0 && opt->pipeline.objective == "shape")
+            if (time_limit->count() > 0 && opt->pipeline.objective == SimplifyOptions::Objective::Shape)
               opt->pipeline.time_bound_seconds = opt->pipeline.time_limit_seconds;
             for (const std::string& out : {opt->output, opt->report, opt->report_html})
               if (!out.empty() && same_file(opt->input, out))
@@ -228,7 +229,6 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             p.ratio = opt->ratio > 0 ? opt->ratio : 1.0;
             p.target_tri_equivalent = opt->faces;
             p.exact_formulation = opt->formulation == "exact";
-            p.strategy = opt->strategy;
             p.consistency = !opt->no_consistency;
             p.segmentation = !opt->no_segmentation;
             p.geometry = !opt->no_geometry;

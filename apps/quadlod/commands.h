@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace quadlod {
 struct SimplifyOptions;
@@ -51,6 +53,31 @@ Command add_batch(CLI::App& app, const GlobalOptions& global);
 /// in `poses` of its rig as well as at the bind pose (deformation-sensitive quadrics).
 int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
                         const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses);
+
+/// An option whose value is one of an enum's names (the `*_names()` of include/quadlod/
+/// simplify.h), stored into `target`: the help lists the names in their order and the default
+/// ("TEXT:{shape,paper}=shape"), any other value is a usage error ("--objective: bogus not in
+/// {shape,paper}"), as CLI::IsMember on a string option gives them.
+template <class E>
+CLI::Option* add_choice_option(CLI::App* sub, const std::string& flag, E& target,
+                               const std::vector<std::pair<std::string, E>>& names, const std::string& help) {
+  std::vector<std::string> keys;
+  std::string current;
+  for (const auto& [name, value] : names) {
+    keys.push_back(name);
+    if (value == target) current = name;
+  }
+  return sub
+      ->add_option_function<std::string>(
+          flag,
+          [&target, names](const std::string& chosen) {
+            for (const auto& [name, value] : names)
+              if (name == chosen) target = value;
+          },
+          help)
+      ->check(CLI::IsMember(keys))
+      ->default_str(current);
+}
 
 /// Prints "quadlod: message" on stderr and returns kExitBadInput.
 int fail(const std::string& message);

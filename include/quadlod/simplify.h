@@ -15,9 +15,9 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace quadlod {
@@ -38,17 +38,25 @@ struct SimplifyOptions {
   double lambda_tri = -1.0;
 
   // --- objective (issue "Shape first"; docs/shape_objective.md) ----------------
-  /// "shape" (default): the selection minimises the geometric error of the mesh it produces
-  /// (cluster quadrics at the collapse's placement, plus the quad-shape term), by a deterministic
-  /// greedy (src/select/shape_selection.h). "paper": Eq. 9 with the MIP / annealing search
-  /// below (the paper's objective, for the ablation table).
-  std::string objective = "shape";
+  /// What the selection minimises (names for the CLI, manifests and Python: "shape", "paper";
+  /// parse_objective below).
+  ///   * Shape (default): the geometric error of the mesh it produces (cluster quadrics at the
+  ///     collapse's placement, plus the quad-shape term), by a deterministic greedy
+  ///     (src/select/shape_selection.h).
+  ///   * Paper: Eq. 9 with the MIP / annealing search below (the paper's objective, for the
+  ///     ablation table).
+  enum class Objective : std::uint8_t { Shape, Paper };
+  Objective objective = Objective::Shape;
   /// Quads joined again from triangle pairs before the reduction (src/mesh/quad_recovery.h;
-  /// docs/scenes.md, "Triangulated inputs"): "auto" (default) when every face of the input is a
-  /// triangle, as glTF and most exporters write them; "on" also for meshes with polygons (their
-  /// triangles are joined where they pair up); "off" never. Blender's thresholds (40°, 40°); on
-  /// six fan-triangulated quad meshes 93–99 % of the quads it makes were input quads.
-  std::string recover_quads = "auto";
+  /// docs/scenes.md, "Triangulated inputs"; names "auto", "on", "off": parse_quad_recovery).
+  /// Blender's thresholds (40°, 40°); on six fan-triangulated quad meshes 93–99 % of the quads it
+  /// makes were input quads.
+  ///   * Auto (default): when every face of the input is a triangle, as glTF and most exporters
+  ///     write them.
+  ///   * On: also for meshes with polygons (their triangles are joined where they pair up).
+  ///   * Off: never.
+  enum class QuadRecovery : std::uint8_t { Auto, On, Off };
+  QuadRecovery recover_quads = QuadRecovery::Auto;
   double lambda_shape = -1.0;             ///< shape term weight; < 0 = the measured default
   double triangle_collapse_factor = -1.0;  ///< handicap of single collapses; < 0 = by ratio (below), 0 = none
   double max_triangle_share = -1.0;        ///< cap of their share of the reduction; < 0 = default
@@ -77,8 +85,8 @@ struct SimplifyOptions {
   /// one (report: time_bound_reached); only then does the output depend on the clock.
   double time_bound_seconds = 0.0;
 
-  // --- solver (objective "paper") --------------------------------------------------------------
-  double time_limit_seconds = 5.0;  ///< MIP time budget (objective "paper"); 0 = greedy selection only
+  // --- solver (Objective::Paper) --------------------------------------------------------------
+  double time_limit_seconds = 5.0;  ///< MIP time budget (Objective::Paper); 0 = greedy selection only
   /// Threads: the shape greedy's first pricing and the collapse's face checks (the output is the
   /// same for any count), CBC and the annealing runs of the paper objective; 0 = all cores.
   int threads = 0;
@@ -89,14 +97,23 @@ struct SimplifyOptions {
   Index min_faces_beside = 20000;
   std::uint32_t seed = 1;
   bool exact_formulation = false;   ///< the paper's per-edge / per-face model (slower)
-  /// "auto", "whole" or "neighbourhoods": how the MIP budget is spent (docs/formulation.md).
-  std::string strategy = "auto";
+  /// How the MIP budget is spent (docs/formulation.md, "Speed"; names "auto", "whole",
+  /// "neighbourhoods": parse_selection_strategy), as SelectionParams::Strategy
+  /// (src/select/selection.h), which the pipeline sets from it: Whole = one MIP over the whole
+  /// model, Neighbourhoods = large-neighbourhood search from the greedy selection, Auto = Whole
+  /// while few groups are free, else Neighbourhoods. The exact formulation always solves the whole
+  /// model.
+  enum class SelectionStrategy : std::uint8_t { Auto, Whole, Neighbourhoods };
+  SelectionStrategy strategy = SelectionStrategy::Auto;
   /// Groups freed per neighbourhood MIP (docs/parameters.md, "Solver strategy").
   Index neighbourhood_groups = 50;
   /// A whole-model MIP stops after this many seconds without a better selection; 0 = never
   /// (SelectionParams::whole_stall_seconds, docs/formulation.md "Stopping").
   double stall_seconds = -1.0;  ///< < 0 = the measured default (default_stall_seconds())
-  std::string solver = "cbc";
+  /// The MIP backend (names: parse_solver_backend), the one of src/ilp's backends
+  /// (ilp::make_solver) of that name; CBC is the only one compiled in.
+  enum class SolverBackend : std::uint8_t { Cbc };
+  SolverBackend solver = SolverBackend::Cbc;
 
   // --- rounds (beyond the paper) ------------------------------------------------------------
   /// Selection → repair → collapse rounds: a round after the first pins the edges whose collapse
@@ -111,12 +128,12 @@ struct SimplifyOptions {
   /// A reduction below this ratio is split into passes of equal ratio, each at most this, each
   /// one run of the whole pipeline on the previous pass's output (src/pipeline/simplify.cpp);
   /// `time_limit_seconds` is shared among the planned passes. In (0, 1); < 0 = the objective's
-  /// measured default: 0.9 for `shape` (docs/shape_objective.md, "Passes"), 0.5 for `paper`
+  /// measured default: 0.9 for Shape (docs/shape_objective.md, "Passes"), 0.5 for Paper
   /// (docs/formulation.md, "Passes").
   double pass_ratio = -1.0;
   /// Most passes, the planned ones and extra ones that aim at N after a miss. 1 = one pass, the
-  /// paper's single global selection. < 0 = the objective's default: 32 for `shape` (0.2 at a
-  /// pass ratio of 0.9 plans 16), 6 for `paper`.
+  /// paper's single global selection. < 0 = the objective's default: 32 for Shape (0.2 at a
+  /// pass ratio of 0.9 plans 16), 6 for Paper.
   int max_passes = -1;
   /// When the output misses Eq. 2's band, run the pipeline again with the greedy selection and
   /// keep the output closer to the target (report: `fallback`). Beyond the paper; off in
@@ -202,12 +219,32 @@ struct SimplifyOptions {
   bool progress = false;
 };
 
-/// SimplifyOptions::SeamPolicy by name ("auto", "strict"), for the CLI, manifests and Python;
-/// nullopt for any other name.
+// The choices of SimplifyOptions by name, for the CLI, manifests and Python; the names are the
+// report's (`options`) too. For each enum: parse_* gives the value of a name (case-sensitive),
+// nullopt for any other name; to_string the name of a value ("?" for a value outside the enum,
+// which simplify() refuses); *_names every name with its value, in declaration order (so the
+// CLI lists them as declared: "{shape,paper}").
+
+/// "auto", "strict".
 std::optional<SimplifyOptions::SeamPolicy> parse_seam_policy(const std::string& name);
 const char* to_string(SimplifyOptions::SeamPolicy policy);
-/// Every name parse_seam_policy takes, with its value.
-std::map<std::string, SimplifyOptions::SeamPolicy> seam_policy_names();
+std::vector<std::pair<std::string, SimplifyOptions::SeamPolicy>> seam_policy_names();
+/// "shape", "paper".
+std::optional<SimplifyOptions::Objective> parse_objective(const std::string& name);
+const char* to_string(SimplifyOptions::Objective objective);
+std::vector<std::pair<std::string, SimplifyOptions::Objective>> objective_names();
+/// "auto", "on", "off".
+std::optional<SimplifyOptions::QuadRecovery> parse_quad_recovery(const std::string& name);
+const char* to_string(SimplifyOptions::QuadRecovery recovery);
+std::vector<std::pair<std::string, SimplifyOptions::QuadRecovery>> quad_recovery_names();
+/// "auto", "whole", "neighbourhoods".
+std::optional<SimplifyOptions::SelectionStrategy> parse_selection_strategy(const std::string& name);
+const char* to_string(SimplifyOptions::SelectionStrategy strategy);
+std::vector<std::pair<std::string, SimplifyOptions::SelectionStrategy>> selection_strategy_names();
+/// "cbc".
+std::optional<SimplifyOptions::SolverBackend> parse_solver_backend(const std::string& name);
+const char* to_string(SimplifyOptions::SolverBackend backend);
+std::vector<std::pair<std::string, SimplifyOptions::SolverBackend>> solver_backend_names();
 
 struct SimplifyResult {
   PolyMesh mesh;       ///< the reduced mesh (the input unchanged when nothing is to do)
@@ -244,8 +281,9 @@ double default_lambda_tri();
 double default_lambda_shape();
 double default_max_triangle_share();
 int default_swap_rounds();
-/// The pass ratio and pass count an objective ("shape" or "paper") uses when none is given.
-double default_pass_ratio(const std::string& objective);
-int default_max_passes(const std::string& objective);
+/// The pass ratio and pass count an objective uses when none is given (SimplifyOptions::
+/// pass_ratio, max_passes; before the shape objective's scaling by `effort`).
+double default_pass_ratio(SimplifyOptions::Objective objective);
+int default_max_passes(SimplifyOptions::Objective objective);
 
 }  // namespace quadlod

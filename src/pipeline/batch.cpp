@@ -43,12 +43,20 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
     if (options.contains("ratio")) simplify.ratio = options["ratio"].get<double>();
     if (options.contains("faces")) simplify.target_tri_equivalent = options["faces"].get<std::uint64_t>();
     if (options.contains("per_mesh")) per_mesh = options["per_mesh"].get<bool>();
-    if (options.contains("objective")) simplify.objective = options["objective"].get<std::string>();
+    if (options.contains("objective")) {
+      const auto objective = parse_objective(options["objective"].get<std::string>());
+      if (!objective) return "objective must be shape or paper";
+      simplify.objective = *objective;
+    }
     if (options.contains("time_limit")) simplify.time_limit_seconds = options["time_limit"].get<double>();
     if (options.contains("threads")) simplify.threads = options["threads"].get<int>();
     if (options.contains("seed")) simplify.seed = options["seed"].get<std::uint32_t>();
     if (options.contains("features")) simplify.features = options["features"].get<bool>();
-    if (options.contains("recover_quads")) simplify.recover_quads = options["recover_quads"].get<std::string>();
+    if (options.contains("recover_quads")) {
+      const auto recovery = parse_quad_recovery(options["recover_quads"].get<std::string>());
+      if (!recovery) return "recover_quads must be auto, on or off";
+      simplify.recover_quads = *recovery;
+    }
     if (options.contains("seams")) {
       const auto policy = parse_seam_policy(options["seams"].get<std::string>());
       if (!policy) return "seams must be auto or strict";
@@ -61,9 +69,6 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
     return std::string("bad option value: ") + e.what();
   }
   if (!(simplify.ratio > 0.0 && simplify.ratio <= 1.0)) return "ratio must be in (0, 1]";
-  if (simplify.objective != "shape" && simplify.objective != "paper") return "objective must be shape or paper";
-  if (simplify.recover_quads != "auto" && simplify.recover_quads != "on" && simplify.recover_quads != "off")
-    return "recover_quads must be auto, on or off";
   if (!is_lod(options) && !options.contains("ratio") && !options.contains("faces"))
     return "no target: give ratio, faces, levels or count";
   if (!format.empty() && format[0] != '.') format = "." + format;

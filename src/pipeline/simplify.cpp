@@ -43,26 +43,94 @@ double default_lambda_tri() { return selection_defaults().lambda_tri; }
 double default_lambda_shape() { return ShapeSelectionParams{}.lambda_shape; }
 double default_max_triangle_share() { return ShapeSelectionParams{}.max_triangle_share; }
 int default_swap_rounds() { return ShapeSelectionParams{}.swap_rounds; }
+// The choices' names (simplify.h): one table per enum, in declaration order; parse, to_string
+// and the CLI's lists all read it.
+using Options = SimplifyOptions;
+
+template <class E>
+std::optional<E> parse_by_name(const std::vector<std::pair<std::string, E>>& names, const std::string& name) {
+  for (const auto& [n, value] : names)
+    if (n == name) return value;
+  return std::nullopt;
+}
+
+std::vector<std::pair<std::string, Options::SeamPolicy>> seam_policy_names() {
+  return {{"auto", Options::SeamPolicy::Auto}, {"strict", Options::SeamPolicy::Strict}};
+}
+std::optional<Options::SeamPolicy> parse_seam_policy(const std::string& name) {
+  return parse_by_name(seam_policy_names(), name);
+}
+const char* to_string(Options::SeamPolicy policy) {
+  switch (policy) {
+    case Options::SeamPolicy::Auto: return "auto";
+    case Options::SeamPolicy::Strict: return "strict";
+  }
+  return "?";
+}
+
+std::vector<std::pair<std::string, Options::Objective>> objective_names() {
+  return {{"shape", Options::Objective::Shape}, {"paper", Options::Objective::Paper}};
+}
+std::optional<Options::Objective> parse_objective(const std::string& name) { return parse_by_name(objective_names(), name); }
+const char* to_string(Options::Objective objective) {
+  switch (objective) {
+    case Options::Objective::Shape: return "shape";
+    case Options::Objective::Paper: return "paper";
+  }
+  return "?";
+}
+
+std::vector<std::pair<std::string, Options::QuadRecovery>> quad_recovery_names() {
+  return {{"auto", Options::QuadRecovery::Auto}, {"on", Options::QuadRecovery::On}, {"off", Options::QuadRecovery::Off}};
+}
+std::optional<Options::QuadRecovery> parse_quad_recovery(const std::string& name) {
+  return parse_by_name(quad_recovery_names(), name);
+}
+const char* to_string(Options::QuadRecovery recovery) {
+  switch (recovery) {
+    case Options::QuadRecovery::Auto: return "auto";
+    case Options::QuadRecovery::On: return "on";
+    case Options::QuadRecovery::Off: return "off";
+  }
+  return "?";
+}
+
+std::vector<std::pair<std::string, Options::SelectionStrategy>> selection_strategy_names() {
+  return {{"auto", Options::SelectionStrategy::Auto},
+          {"whole", Options::SelectionStrategy::Whole},
+          {"neighbourhoods", Options::SelectionStrategy::Neighbourhoods}};
+}
+std::optional<Options::SelectionStrategy> parse_selection_strategy(const std::string& name) {
+  return parse_by_name(selection_strategy_names(), name);
+}
+const char* to_string(Options::SelectionStrategy strategy) {
+  switch (strategy) {
+    case Options::SelectionStrategy::Auto: return "auto";
+    case Options::SelectionStrategy::Whole: return "whole";
+    case Options::SelectionStrategy::Neighbourhoods: return "neighbourhoods";
+  }
+  return "?";
+}
+
+// The names are ilp::make_solver's (src/ilp/solver.cpp), which the pipeline hands the name.
+std::vector<std::pair<std::string, Options::SolverBackend>> solver_backend_names() {
+  return {{"cbc", Options::SolverBackend::Cbc}};
+}
+std::optional<Options::SolverBackend> parse_solver_backend(const std::string& name) {
+  return parse_by_name(solver_backend_names(), name);
+}
+const char* to_string(Options::SolverBackend backend) {
+  switch (backend) {
+    case Options::SolverBackend::Cbc: return "cbc";
+  }
+  return "?";
+}
+
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
 // ratios 0.5 / 0.7 / 0.85 / 0.9 / 0.95 gave Chamfer 0.98 / 0.96 / 0.90 / 0.88 / 0.85 of Single's
 // at 0.4 and 1.12 / 1.06 / 0.98 / 0.95 / 0.94 at 0.2, at 1.0 / 1.1 / 1.5 / 1.8 / 3.1 s in all.
-std::map<std::string, SimplifyOptions::SeamPolicy> seam_policy_names() {
-  return {{"auto", SimplifyOptions::SeamPolicy::Auto}, {"strict", SimplifyOptions::SeamPolicy::Strict}};
-}
-
-std::optional<SimplifyOptions::SeamPolicy> parse_seam_policy(const std::string& name) {
-  const auto names = seam_policy_names();
-  const auto it = names.find(name);
-  if (it == names.end()) return std::nullopt;
-  return it->second;
-}
-
-const char* to_string(SimplifyOptions::SeamPolicy policy) {
-  return policy == SimplifyOptions::SeamPolicy::Strict ? "strict" : "auto";
-}
-
-double default_pass_ratio(const std::string& objective) { return objective == "paper" ? 0.5 : 0.9; }
-int default_max_passes(const std::string& objective) { return objective == "paper" ? 6 : 32; }
+double default_pass_ratio(Options::Objective objective) { return objective == Options::Objective::Paper ? 0.5 : 0.9; }
+int default_max_passes(Options::Objective objective) { return objective == Options::Objective::Paper ? 6 : 32; }
 
 namespace {
 
@@ -227,7 +295,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ap.segmentation.enable = options.segmentation;
   ap.segmentation.epsilon_theta = options.epsilon_theta_deg * std::numbers::pi / 180.0;
   ap.segmentation.threads = options.threads;
-  ap.clusters = options.objective == "paper";
+  ap.clusters = options.objective == SimplifyOptions::Objective::Paper;
   AnalysisResult analysis;
   // The vertex quadrics of this pass's input, once for the shape selection and every collapse
   // round (geometry/cluster_quadric.h: the placement both use).
@@ -349,7 +417,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     // The objective (issue "Shape first"): the shape greedy by default, Eq. 9 with `paper`.
     std::optional<ShapeSelectionStats> shape_stats;
     SelectionResult selection;
-    if (options.objective == "shape") {
+    if (options.objective == SimplifyOptions::Objective::Shape) {
       shp.keep_edges = sp.keep_edges;
       shp.consistency = sp.consistency;
       ShapeSelectionResult shaped =
@@ -439,7 +507,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
       report["selection"] = solve_json(selection);
       report["selection"]["seconds"] = select_seconds;
       report["selection"]["quads_to_triangles"] = predicted_new_triangles(input, conn, selection.edge_kept);
-      report["selection"]["objective_kind"] = options.objective;
+      report["selection"]["objective_kind"] = to_string(options.objective);
       if (shape_stats)
         report["selection"]["shape"] = {
             {"cost", shape_stats->cost},
@@ -542,9 +610,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   // E plans E times the passes of the default ratio (pass ratio r^(1/E)), each re-reading the
   // layout; docs/shape_objective.md ("Effort") has the measured trade-off.
   const double effort = options.effort;
+  const bool shape = options.objective == SimplifyOptions::Objective::Shape;
   const double pass_ratio = options.pass_ratio >= 0.0 ? options.pass_ratio
-                            : options.objective == "shape" ? std::pow(default_pass_ratio(options.objective), 1.0 / effort)
-                                                           : default_pass_ratio(options.objective);
+                            : shape                    ? std::pow(default_pass_ratio(options.objective), 1.0 / effort)
+                                                       : default_pass_ratio(options.objective);
   if (!(pass_ratio > 0.0 && pass_ratio < 1.0)) {
     result.error = "the pass ratio must be in (0, 1)";
     return result;
@@ -568,22 +637,17 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   sp.neighbourhood_groups = std::max<Index>(1, options.neighbourhood_groups);
   if (options.stall_seconds >= 0.0)
     sp.whole_stall_seconds = options.stall_seconds > 0.0 ? options.stall_seconds : ilp::kInf;
-  if (options.strategy == "whole") sp.strategy = SelectionParams::Strategy::Whole;
-  else if (options.strategy == "neighbourhoods") sp.strategy = SelectionParams::Strategy::Neighbourhoods;
-  else if (options.strategy != "auto") {
-    result.error = "unknown solver strategy '" + options.strategy + "' (auto, whole, neighbourhoods)";
-    return result;
+  switch (options.strategy) {  // the public mirror of SelectionParams::Strategy (simplify.h)
+    case SimplifyOptions::SelectionStrategy::Auto: sp.strategy = SelectionParams::Strategy::Auto; break;
+    case SimplifyOptions::SelectionStrategy::Whole: sp.strategy = SelectionParams::Strategy::Whole; break;
+    case SimplifyOptions::SelectionStrategy::Neighbourhoods: sp.strategy = SelectionParams::Strategy::Neighbourhoods; break;
   }
   sp.consistency = options.consistency;
   sp.geometry = options.geometry;
-  sp.solver = options.solver;
+  sp.solver = to_string(options.solver);  // ilp::make_solver knows the backends by these names
   sp.solve.threads = options.threads;
   sp.solve.seed = options.seed;
   sp.quiet = !options.progress;
-  if (options.objective != "shape" && options.objective != "paper") {
-    result.error = "unknown objective '" + options.objective + "' (shape, paper)";
-    return result;
-  }
   ShapeSelectionParams shp;
   shp.epsilon_n = options.epsilon_n;
   shp.threads = options.threads;
@@ -643,13 +707,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   // docs/formulation.md ("Passes") has the measurements.
   const double n0 = double(result.input_tri_equivalent), n = double(result.target);
   const int max_passes = std::max(1, options.max_passes >= 0 ? options.max_passes
-                                     : options.objective == "shape" ? int(std::ceil(default_max_passes(options.objective) * effort))
-                                                                    : default_max_passes(options.objective));
+                                     : shape                  ? int(std::ceil(default_max_passes(options.objective) * effort))
+                                                              : default_max_passes(options.objective));
   int planned = 1;
   if (n < n0 && n > 0.0)
     planned = std::clamp(static_cast<int>(std::ceil(std::log(n / n0) / std::log(pass_ratio) - 1e-9)), 1, max_passes);
   // The paper objective's search is clock-driven: effort scales its MIP budget.
-  const double pass_time = options.time_limit_seconds * (options.objective == "shape" ? 1.0 : effort) / planned;
+  const double pass_time = options.time_limit_seconds * (shape ? 1.0 : effort) / planned;
   bool time_bound_reached = false;
   // Every pass checks orientation against the original input surface (docs/metrics.md §6b) ...
   std::optional<SurfaceReference> surface;
@@ -939,7 +1003,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"threads", ilp::backend::resolve_threads(sp.solve)},  // 0 (all cores) resolved
       {"seed", options.seed},
       {"formulation", options.exact_formulation ? "exact" : "fast"},
-      {"strategy", options.strategy},
+      {"strategy", to_string(options.strategy)},
       {"neighbourhood_groups", sp.neighbourhood_groups},
       {"stall_seconds", std::isfinite(sp.whole_stall_seconds) ? nlohmann::json(sp.whole_stall_seconds) : nlohmann::json()},
       {"consistency", options.consistency},
@@ -952,7 +1016,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"place_on_hard_edges", options.place_on_hard_edges},
       {"surface_fit_iterations", options.surface_fit_iterations},
       {"surface_fit_vertex_weight", options.surface_fit_vertex_weight},
-      {"recover_quads", options.recover_quads},
+      {"recover_quads", to_string(options.recover_quads)},
       {"seams", to_string(options.seams)},
       {"skin_poses", input.skin.empty() ? 0 : options.skin_poses.size()},
       {"max_rounds", options.max_rounds},
@@ -963,7 +1027,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"time_bound_seconds", options.time_bound_seconds},
       {"max_passes", max_passes},
       {"greedy_fallback", options.greedy_fallback},
-      {"objective", options.objective},
+      {"objective", to_string(options.objective)},
       {"lambda_shape", shp.lambda_shape},
       {"triangle_collapse_factor", shp.triangle_collapse_factor},
       {"max_triangle_share", shp.max_triangle_share},
@@ -990,7 +1054,7 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
     return r.target ? std::abs(double(r.achieved) - double(r.target)) / double(r.target) : 0.0;
   };
   // The shape objective's selection is a greedy already: there is nothing to fall back to.
-  if (!optimised.ok() || options.objective != "paper" || !options.greedy_fallback || !(options.time_limit_seconds > 0.0) ||
+  if (!optimised.ok() || options.objective != SimplifyOptions::Objective::Paper || !options.greedy_fallback || !(options.time_limit_seconds > 0.0) ||
       optimised.target >= optimised.input_tri_equivalent || miss(optimised) <= options.epsilon_n)
     return optimised;
   if (options.progress)
@@ -1026,14 +1090,32 @@ static SimplifyResult simplify_on(const PolyMesh& input, const SimplifyOptions& 
 
 namespace {
 
-std::string check_recover_quads(const SimplifyOptions& options) {
-  if (options.recover_quads == "auto" || options.recover_quads == "on" || options.recover_quads == "off") return {};
-  return "unknown recover_quads '" + options.recover_quads + "' (auto, on, off)";
+// A choice of SimplifyOptions outside its enum (a cast, a corrupt struct): "" when it has a name,
+// else the error naming the field, the value and the names.
+template <class E>
+std::string check_choice(const char* field, E value, const std::vector<std::pair<std::string, E>>& names) {
+  std::string list;
+  for (const auto& [name, v] : names) {
+    if (v == value) return {};
+    list += (list.empty() ? "" : ", ") + name;
+  }
+  return std::string("unknown ") + field + " " + std::to_string(static_cast<int>(value)) + " (" + list + ")";
+}
+
+std::string check_choices(const SimplifyOptions& options) {
+  for (std::string bad : {check_choice("objective", options.objective, objective_names()),
+                          check_choice("recover_quads", options.recover_quads, quad_recovery_names()),
+                          check_choice("solver strategy", options.strategy, selection_strategy_names()),
+                          check_choice("solver", options.solver, solver_backend_names()),
+                          check_choice("seams", options.seams, seam_policy_names())})
+    if (!bad.empty()) return bad;
+  return {};
 }
 
 // SimplifyOptions::recover_quads: whether this input's triangle pairs are joined first.
 bool joins_triangles(const PolyMesh& input, const SimplifyOptions& options) {
-  return options.recover_quads == "on" || (options.recover_quads == "auto" && all_triangles(input));
+  return options.recover_quads == SimplifyOptions::QuadRecovery::On ||
+         (options.recover_quads == SimplifyOptions::QuadRecovery::Auto && all_triangles(input));
 }
 
 // The reduction of the input with its triangle pairs joined (the same vertices, so every
@@ -1042,19 +1124,19 @@ bool joins_triangles(const PolyMesh& input, const SimplifyOptions& options) {
 SimplifyResult simplify_recovered(const PolyMesh& input, const SimplifyOptions& options) {
   QuadRecoveryResult recovered = recover_quads(input);
   SimplifyOptions rest = options;
-  rest.recover_quads = "off";
+  rest.recover_quads = SimplifyOptions::QuadRecovery::Off;
   SimplifyResult result = simplify_in_place(recovered.mesh, rest);
   result.report["quad_recovery"] = {{"input_faces", input.num_faces()},
                                     {"candidates", recovered.candidates},
                                     {"quads_made", recovered.joined},
                                     {"faces_after", recovered.mesh.num_faces()}};
-  result.report["options"]["recover_quads"] = options.recover_quads;
+  result.report["options"]["recover_quads"] = to_string(options.recover_quads);
   return result;
 }
 
-// What both entry points do first: refuse a bad recover_quads, or reduce the joined input.
+// What both entry points do first: refuse a choice outside its enum, or reduce the joined input.
 std::optional<SimplifyResult> refused_or_recovered(const PolyMesh& input, const SimplifyOptions& options) {
-  if (std::string bad = check_recover_quads(options); !bad.empty()) {
+  if (std::string bad = check_choices(options); !bad.empty()) {
     SimplifyResult r;
     r.error = std::move(bad);
     return r;
