@@ -55,7 +55,12 @@ TEST_F(CliTest, SeamsStrictKeepsEveryPartAndSaysWhyItStopped) {
   EXPECT_NE(run.out.find("+150.0 %"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("with --seams strict no line merges through an island and no part vanishes"), std::string::npos)
       << run.out;
-  EXPECT_EQ(run_cli("simplify " + mesh.string() + " -o " + (dir / "x.obj").string() + " --seams sometimes", dir).exit_code, 1);
+  const auto bad = run_cli("simplify " + mesh.string() + " -o " + (dir / "x.obj").string() + " --seams sometimes", dir);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--seams: sometimes not in {auto,strict}"), std::string::npos) << bad.err;
+  // The help names the choices and the default as the other choices do (it printed NUL bytes).
+  for (const char* sub : {"simplify", "lod"})
+    EXPECT_NE(run_cli(std::string(sub) + " --help", dir).out.find("--seams TEXT:{auto,strict}=auto"), std::string::npos) << sub;
   ASSERT_EQ(run_cli("-q lod " + mesh.string() + " -o " + (dir / "lods").string() + " --levels 0.4 --format obj --seams strict", dir).exit_code, 0);
   const auto lods = nlohmann::json::parse(slurp(dir / "lods" / "lods.json"));
   EXPECT_EQ(lods["levels"][0]["achieved"], 50) << lods.dump();

@@ -49,9 +49,8 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   add_choice_option(sub, "--recover-quads", p.recover_quads, quad_recovery_names(),
                     "All-triangle inputs: join triangle pairs into quads first (auto, on, off; as in simplify)")
       ->group("Reduction");
-  sub->add_option("--seams", p.seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
-      ->transform(CLI::CheckedTransformer(seam_policy_names(), CLI::ignore_case))
-      ->default_str("auto")
+  add_choice_option(sub, "--seams", p.seams, seam_policy_names(),
+                    "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->group("Reduction");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")

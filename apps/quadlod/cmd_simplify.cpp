@@ -137,12 +137,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-features", opt->no_features,
                 "Do not protect UV seams, material borders, boundaries and hard edges; keep each corner's input UV")
       ->group("Features");
-  sub->add_option("--seams", p.seams,
-                  "Strict lines (UV seams, material borders, boundaries) below the budget they leave room for: auto (the "
-                  "lines around the smallest islands may merge through them when a pass stalls, counted in the report), "
-                  "strict (never; the note says how far from the target that stopped)")
-      ->transform(CLI::CheckedTransformer(seam_policy_names(), CLI::ignore_case))
-      ->default_str("auto")
+  add_choice_option(sub, "--seams", p.seams, seam_policy_names(),
+                    "Strict lines (UV seams, material borders, boundaries) below the budget they leave room for: auto (the "
+                    "lines around the smallest islands may merge through them when a pass stalls, counted in the report), "
+                    "strict (never; the note says how far from the target that stopped)")
       ->group("Features");
   sub->add_flag("--place-on-hard-edges", p.place_on_hard_edges,
                 "Keep merged vertices on hard edges (else they follow their quadric, which weighs sharp edges heavily)")
