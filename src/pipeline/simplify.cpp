@@ -53,6 +53,13 @@ std::optional<E> parse_by_name(const std::vector<std::pair<std::string, E>>& nam
     if (n == name) return value;
   return std::nullopt;
 }
+// `names` must outlive the returned pointer (the callers' tables are function-local statics).
+template <class E>
+const char* name_of(const std::vector<std::pair<std::string, E>>& names, E value) {
+  for (const auto& [n, v] : names)
+    if (v == value) return n.c_str();
+  return "?";
+}
 
 std::vector<std::pair<std::string, Options::SeamPolicy>> seam_policy_names() {
   return {{"auto", Options::SeamPolicy::Auto}, {"strict", Options::SeamPolicy::Strict}};
@@ -61,11 +68,8 @@ std::optional<Options::SeamPolicy> parse_seam_policy(const std::string& name) {
   return parse_by_name(seam_policy_names(), name);
 }
 const char* to_string(Options::SeamPolicy policy) {
-  switch (policy) {
-    case Options::SeamPolicy::Auto: return "auto";
-    case Options::SeamPolicy::Strict: return "strict";
-  }
-  return "?";
+  static const auto names = seam_policy_names();
+  return name_of(names, policy);
 }
 
 std::vector<std::pair<std::string, Options::Objective>> objective_names() {
@@ -73,11 +77,8 @@ std::vector<std::pair<std::string, Options::Objective>> objective_names() {
 }
 std::optional<Options::Objective> parse_objective(const std::string& name) { return parse_by_name(objective_names(), name); }
 const char* to_string(Options::Objective objective) {
-  switch (objective) {
-    case Options::Objective::Shape: return "shape";
-    case Options::Objective::Paper: return "paper";
-  }
-  return "?";
+  static const auto names = objective_names();
+  return name_of(names, objective);
 }
 
 std::vector<std::pair<std::string, Options::QuadRecovery>> quad_recovery_names() {
@@ -87,12 +88,8 @@ std::optional<Options::QuadRecovery> parse_quad_recovery(const std::string& name
   return parse_by_name(quad_recovery_names(), name);
 }
 const char* to_string(Options::QuadRecovery recovery) {
-  switch (recovery) {
-    case Options::QuadRecovery::Auto: return "auto";
-    case Options::QuadRecovery::On: return "on";
-    case Options::QuadRecovery::Off: return "off";
-  }
-  return "?";
+  static const auto names = quad_recovery_names();
+  return name_of(names, recovery);
 }
 
 std::vector<std::pair<std::string, Options::SelectionStrategy>> selection_strategy_names() {
@@ -104,12 +101,8 @@ std::optional<Options::SelectionStrategy> parse_selection_strategy(const std::st
   return parse_by_name(selection_strategy_names(), name);
 }
 const char* to_string(Options::SelectionStrategy strategy) {
-  switch (strategy) {
-    case Options::SelectionStrategy::Auto: return "auto";
-    case Options::SelectionStrategy::Whole: return "whole";
-    case Options::SelectionStrategy::Neighbourhoods: return "neighbourhoods";
-  }
-  return "?";
+  static const auto names = selection_strategy_names();
+  return name_of(names, strategy);
 }
 
 // The names are ilp::make_solver's (src/ilp/solver.cpp), which the pipeline hands the name.
@@ -120,10 +113,8 @@ std::optional<Options::SolverBackend> parse_solver_backend(const std::string& na
   return parse_by_name(solver_backend_names(), name);
 }
 const char* to_string(Options::SolverBackend backend) {
-  switch (backend) {
-    case Options::SolverBackend::Cbc: return "cbc";
-  }
-  return "?";
+  static const auto names = solver_backend_names();
+  return name_of(names, backend);
 }
 
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
