@@ -14,7 +14,7 @@ namespace quadlod::protect_detail {
 /// The measured defaults of SimplifyOptions::protect_strength and protect_importance
 /// (docs/protect.md, "Partial weights").
 inline constexpr double kDefaultStrength = 16.0;
-inline constexpr double kDefaultImportance = 4.0;
+inline constexpr double kDefaultImportance = 50.0;
 
 /// 1 for the vertices of weight 1 (protected), else 0.
 std::vector<std::uint8_t> protected_flags(const std::vector<double>& weights);
