@@ -307,6 +307,18 @@ void Collapser::check_vertex(Index v) {
   if (!protected_.empty() && cluster_size(v) > 1 && !protection_valid(v)) blame(v, CollapseRefusal::Protected);
   gather_fan(v);
   const Index nfan = static_cast<Index>(fan_.size());
+  // Issue 34: a protected vertex keeps a face. When every face around it was dropped (its
+  // neighbours merged, or its part shrank away), the clusters around it are refused.
+  if (!protected_.empty() && nfan == 0) {
+    bool holds = false;
+    for (Index m : members(v)) holds = holds || protected_[m];
+    if (holds)
+      for (Index m : members(v))
+        for (Index c : conn_.corners_at_vertex(m)) {
+          const Index f = conn_.corner_face[c];
+          for (Index k = mesh_.face_begin(f); k < mesh_.face_end(f); ++k) blame(root_of_corner(k), CollapseRefusal::Protected);
+        }
+  }
   nbr_.clear();
   for (Index i = 0; i < nfan; ++i) {
     const FanEntry& fe = fan_[i];
