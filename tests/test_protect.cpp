@@ -211,6 +211,29 @@ TEST(Protect, CollapseLandsOnTheProtectedMemberAndRefusesTwo) {
   EXPECT_EQ(two.mesh.positions[two.vertex_map[id(3, 2)]], grid.positions[id(3, 2)]);
 }
 
+// A protected vertex keeps a face: a cluster that would drop the last face around it (here the
+// seven other corners of a cube merged into one, which leaves no face; feature rules off, so
+// nothing else refuses it) is refused; unprotected, the same collapse leaves vertex 0 unused.
+TEST(Protect, ClusterThatDropsTheLastFaceOfAProtectedVertexIsRefused) {
+  const PolyMesh cube = make_cube(1, 1.0);
+  ASSERT_EQ(cube.num_vertices(), 8u);
+  const Connectivity conn = build_connectivity(cube);
+  std::vector<std::uint8_t> kept(conn.num_edges, 1);
+  for (Index e = 0; e < conn.num_edges; ++e)
+    if (conn.edge_vertices[e][0] != 0 && conn.edge_vertices[e][1] != 0) kept[e] = 0;
+  ClusterCollapseParams params;
+  params.respect_features = false;
+  const ClusterCollapseResult plain = collapse_clusters(cube, conn, kept, params);
+  ASSERT_EQ(plain.vertex_map[0], kInvalidIndex) << "the collapse must drop vertex 0's faces";
+  std::vector<std::uint8_t> prot(cube.num_vertices(), 0);
+  prot[0] = 1;
+  params.protected_vertices = &prot;
+  const ClusterCollapseResult guarded = collapse_clusters(cube, conn, kept, params);
+  ASSERT_NE(guarded.vertex_map[0], kInvalidIndex);
+  EXPECT_EQ(guarded.mesh.positions[guarded.vertex_map[0]], cube.positions[0]);
+  EXPECT_GE(guarded.stats.refusals(CollapseRefusal::Protected), 1u);
+}
+
 // LOD chains carry the weights from level to level (level ℓ is reduced from level ℓ − 1).
 TEST(Protect, LodChainKeepsProtectedVerticesAtEveryLevel) {
   const PolyMesh grid = bumpy_grid(24);
