@@ -8,6 +8,7 @@
 #include "quadlod/io.h"
 #include "quadlod/lod.h"
 #include "quadlod/protect.h"
+#include "quadlod/scene.h"
 #include "quadlod/simplify.h"
 
 #include <gtest/gtest.h>
@@ -119,6 +120,20 @@ TEST(Protect, ProtectedRegionOfAGridComesOutUntouched) {
   plain.protect_weights.clear();
   const SimplifyResult p = simplify(grid, plain);
   EXPECT_GT(check_protected(grid, w, p.mesh).moved, 50u);
+}
+
+// Everything at weight 1: nothing may merge, the mesh comes back as it was, and the note names the
+// protection as the constraint that held the count up.
+TEST(Protect, WhollyProtectedMeshComesBackUnchangedAndTheNoteSaysWhy) {
+  const PolyMesh grid = bumpy_grid(6);
+  SimplifyOptions options;
+  options.ratio = 0.3;
+  options.protect_weights.assign(grid.num_vertices(), 1.0);
+  const SimplifyResult r = simplify(grid, options);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.mesh.positions, grid.positions);
+  EXPECT_EQ(r.mesh.corner_vertex, grid.corner_vertex);
+  EXPECT_NE(r.note.find("protect: 84 edges pinned between weight-1 vertices"), std::string::npos) << r.note;
 }
 
 // Weight-1 vertices scattered over a curved mesh whose coordinates are not float32 values (the
@@ -373,6 +388,53 @@ TEST_F(ProtectFile, CliSimplifyLodAndBatchTakeProtectFiles) {
       EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
     }
   }
+}
+
+// glTF COLOR_0 through assimp (issue 34, item 2): a .glb scene of a grid with red = 1 on a region
+// and a torus without colours; `--protect-from color:r` keeps the grid's red vertices exactly and
+// leaves the torus unprotected; a file for the whole scene (mesh after mesh) must hold one weight
+// per vertex of both meshes.
+TEST_F(ProtectFile, GlbColourChannelProtectsThroughTheScenePath) {
+  Scene scene;
+  PolyMesh grid = bumpy_grid(16);
+  for (const Vec3& p : grid.positions) grid.vertex_colors.emplace_back(p.x() > 0.7 ? 1.0 : 0.0, 0.5, 0.5);
+  scene.meshes = {{"grid", std::move(grid)}, {"torus", make_torus(24, 12)}};
+  scene.nodes = {SceneNode{"root", kInvalidIndex, Eigen::Matrix4d::Identity(), {}},
+                 SceneNode{"grid", 0, Eigen::Matrix4d::Identity(), {0}},
+                 SceneNode{"torus", 0, Eigen::Matrix4d::Identity(), {1}}};
+  scene.nodes[2].local(0, 3) = 3.0;  // beside the grid
+  const std::string in = (dir / "in.glb").string(), out = (dir / "out.glb").string();
+  ASSERT_TRUE(write_scene(scene, in).ok());
+  const SceneReadResult before = read_scene(in);
+  ASSERT_TRUE(before.ok()) << before.error;
+  ASSERT_EQ(before.scene.meshes.size(), 2u);
+  const PolyMesh& read_grid = before.scene.meshes[0].mesh.vertex_colors.empty() ? before.scene.meshes[1].mesh
+                                                                                : before.scene.meshes[0].mesh;
+  const std::vector<double> w = protect_weights_from_colors(read_grid, SimplifyOptions::ProtectChannel::Red);
+  ASSERT_GT(std::count(w.begin(), w.end(), 1.0), 40);
+
+  CliRun run = run_cli("-q simplify '" + in + "' -o '" + out + "' --ratio 0.3 --protect-from color:r", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const SceneReadResult after = read_scene(out);
+  ASSERT_TRUE(after.ok()) << after.error;
+  PolyMesh all;
+  for (const SceneMesh& m : after.scene.meshes) all.positions.insert(all.positions.end(), m.mesh.positions.begin(), m.mesh.positions.end());
+  const auto at = exact_positions(all);
+  Index moved = 0;
+  for (Index v = 0; v < read_grid.num_vertices(); ++v) moved += w[v] >= 1.0 && !at.count(key(read_grid.positions[v]));
+  EXPECT_EQ(moved, 0u);
+
+  std::size_t vertices = 0;
+  for (const SceneMesh& m : before.scene.meshes) vertices += m.mesh.num_vertices();
+  std::string text;
+  for (std::size_t v = 0; v + 1 < vertices; ++v) text += "0\n";
+  const std::string weights = write("scene_w.txt", text);
+  run = run_cli("-q simplify '" + in + "' -o '" + out + "' --ratio 0.3 --protect '" + weights + "'", dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("scene_w.txt: " + std::to_string(vertices - 1) + " weights, the mesh has " +
+                         std::to_string(vertices) + " vertices"),
+            std::string::npos)
+      << run.err;
 }
 
 }  // namespace

@@ -153,14 +153,27 @@ SceneLodResult lod_chain_scene(const Scene& input, const LodChainParams& params)
       return result;
     }
   }
+  // Weights from a colour channel: meshes without vertex colours are not protected (as simplify_scene).
+  const bool by_colour = params.simplify.protect_weights.empty() &&
+                         params.simplify.protect_channel != SimplifyOptions::ProtectChannel::None;
+  if (by_colour && std::none_of(input.meshes.begin(), input.meshes.end(),
+                                [](const SceneMesh& m) { return !m.mesh.vertex_colors.empty(); })) {
+    result.error = std::string("protect from ") + to_string(params.simplify.protect_channel) +
+                   ": no mesh of the scene has vertex colours";
+    result.levels.clear();
+    return result;
+  }
   std::uint64_t input_te = 0;
   for (std::size_t m = 0; m < input.meshes.size(); ++m) {
+    const bool own = !protect.empty() || (by_colour && input.meshes[m].mesh.vertex_colors.empty());
     LodChainParams mesh_params;
-    if (!protect.empty()) {
+    if (own) {
       mesh_params = params;
-      mesh_params.simplify.protect_weights = std::move(protect[m]);
+      if (!protect.empty()) mesh_params.simplify.protect_weights = std::move(protect[m]);
+      if (by_colour && input.meshes[m].mesh.vertex_colors.empty())
+        mesh_params.simplify.protect_channel = SimplifyOptions::ProtectChannel::None;
     }
-    const LodChainResult chain = lod_chain(input.meshes[m].mesh, protect.empty() ? params : mesh_params);
+    const LodChainResult chain = lod_chain(input.meshes[m].mesh, own ? mesh_params : params);
     if (!chain.ok()) {
       result.error = "mesh '" + input.meshes[m].name + "': " + chain.error;
       result.levels.clear();

@@ -5,6 +5,7 @@
 #include "quadlod/metrics.h"
 #include "quadlod/protect.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -31,11 +32,20 @@ SceneSimplifyResult simplify_scene(const Scene& input, const SceneSimplifyParams
     }
   }
   result.report = {{"per_mesh", params.per_mesh}, {"meshes", nlohmann::json::array()}};
+  // Weights from a colour channel (issue 34): meshes without vertex colours are not protected; a
+  // scene where none has them is an error, as for one mesh.
+  const bool by_colour = base.protect_weights.empty() && base.protect_channel != SimplifyOptions::ProtectChannel::None;
+  if (by_colour && std::none_of(input.meshes.begin(), input.meshes.end(),
+                                [](const SceneMesh& m) { return !m.mesh.vertex_colors.empty(); })) {
+    result.error = std::string("protect from ") + to_string(base.protect_channel) + ": no mesh of the scene has vertex colours";
+    return result;
+  }
   for (std::size_t m = 0; m < input.meshes.size(); ++m) {
     const SceneMesh& mesh = input.meshes[m];
     const std::uint64_t te = tri_equivalent_count(mesh.mesh);
     SimplifyOptions options = base;
     if (!protect.empty()) options.protect_weights = std::move(protect[m]);
+    if (by_colour && mesh.mesh.vertex_colors.empty()) options.protect_channel = SimplifyOptions::ProtectChannel::None;
     if (absolute && !params.per_mesh) {
       // The scene's target N split by size: mesh i gets N · te_i / Σ te (at least 1).
       const double share = result.input_tri_equivalent > 0 ? double(te) / double(result.input_tri_equivalent) : 0.0;

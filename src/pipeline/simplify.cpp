@@ -1007,6 +1007,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                     static_cast<unsigned long long>(result.target), result.passes_used,
                     result.passes_used == 1 ? "" : "es", static_cast<unsigned>(last.refusals));
     result.note = std::string(text) + costliest_refusals();
+    // Issue 34: the protected vertices' pins are hard constraints too; say so.
+    if (protect_given && last.report.contains("protect"))
+      result.note += "; protect: " + std::to_string(last.report["protect"]["pinned_edges"].get<Index>()) +
+                     " edges pinned between weight-1 vertices in the last pass, which may absorb neighbours but not each other";
     if (options.seams == SimplifyOptions::SeamPolicy::Strict && options.features)
       result.note += "; with --seams strict no line merges through an island and no part vanishes (--seams auto "
                      "lets the smallest islands cross when a pass stalls)";
