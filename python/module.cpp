@@ -11,6 +11,7 @@
 #include "quadlod/io.h"
 #include "quadlod/metrics.h"
 #include "quadlod/lod.h"
+#include "quadlod/protect.h"
 #include "quadlod/simplify.h"
 
 #include <pybind11/stl.h>
@@ -96,6 +97,16 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"geometry", set_field(&SimplifyOptions::geometry)},
       {"dual_repair", set_field(&SimplifyOptions::dual_repair)},
       {"progress", set_field(&SimplifyOptions::progress)},
+      // Issue 34 (docs/protect.md): one weight per vertex in [0, 1] (a 1-D array or sequence), or
+      // a colour channel; simplify() checks the count and the range.
+      {"protect", [](SimplifyOptions& o, const py::handle& v) {
+         const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
+         if (!a || a.ndim() != 1) throw py::type_error("protect: a 1-D array of one weight per vertex, in [0, 1]");
+         o.protect_weights.assign(a.data(), a.data() + a.size());
+       }},
+      {"protect_from", set_choice(&SimplifyOptions::protect_channel, "protect_from", protect_channel_names())},
+      {"protect_strength", set_field(&SimplifyOptions::protect_strength)},
+      {"protect_importance", set_field(&SimplifyOptions::protect_importance)},
   };
   return table;
 }
@@ -176,6 +187,12 @@ py::dict result_to_dict(const SimplifyResult& r, bool uvs_as_dict) {
   report["passes_used"] = r.passes_used;
   report["note"] = r.note;
   out["report"] = json_to_python(report);
+  // Issue 34: the output vertices' protect weights (the largest of the vertices merged into each).
+  if (!r.protect_weights.empty()) {
+    py::array_t<double> weights(static_cast<py::ssize_t>(r.protect_weights.size()));
+    std::copy(r.protect_weights.begin(), r.protect_weights.end(), weights.mutable_data());
+    out["protect"] = weights;
+  }
   return out;
 }
 
@@ -288,8 +305,10 @@ ratio: target as a fraction of the input's triangle-equivalents (quad = 2, k-gon
 faces_target: that count. uvs: per-corner (C, 2) or {name: (C, 2)}; normals: per-corner (C, 3);
 materials: per-face slot index (F,). Further keywords are the CLI's options with '_' for '-'
 (objective, effort, time_limit, time_bound, threads, seed, features, hard_angle, max_hausdorff, pass_ratio,
-surface_fit, surface_fit_vertex_weight, ...).
-Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials] of the reduced mesh and
+surface_fit, surface_fit_vertex_weight, ...). protect: one weight per vertex in [0, 1] (V,) — 1 keeps
+the vertex exactly and the edges between such vertices, between 0 and 1 makes collapses there
+cost more (docs/protect.md); or protect_from='color:r' (the vertex colours' channel).
+Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials, protect] of the reduced mesh and
 report (the JSON report of `simplify --report`, plus target/achieved/quads/triangles/ngons).
 Raises QuadlodError with the CLI's message on bad input.)");
 

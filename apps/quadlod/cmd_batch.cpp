@@ -21,6 +21,7 @@ struct BatchCliOptions {
   std::string objective;
   std::string recover_quads;
   std::string seams;
+  std::string protect_from;  // issue 34
   int threads = -1;
 };
 
@@ -50,6 +51,9 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"auto", "strict"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
+  sub->add_option("--protect-from", opt->protect_from,
+                  "Protect weights from a vertex colour channel (as in simplify; a manifest line's \"protect\": FILE names a weight file)")
+      ->check(CLI::IsMember({"none", "color:r", "color:g", "color:b"}));  // issue 34
   sub->add_option("--shard", opt->shard,
                   "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
                   "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT or $JOB_COMPLETION_INDEX/N")
@@ -72,6 +76,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (!opt->seams.empty()) defaults["seams"] = opt->seams;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
+            if (!opt->protect_from.empty()) defaults["protect_from"] = opt->protect_from;  // issue 34
             const bool folder = std::filesystem::is_directory(opt->source);
             if (folder && opt->output_dir.empty()) {
               std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");

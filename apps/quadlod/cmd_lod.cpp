@@ -3,6 +3,7 @@
 // level plus DIR/lods.json (docs/lod.md).
 #include "commands.h"
 
+#include "protect_cli.h"
 #include "quadlod/lod.h"
 #include "quadlod/scene.h"
 #include "util/progress.h"
@@ -21,6 +22,7 @@ struct LodCliOptions {
   int count = 0;
   LodChainParams chain;
   bool no_features = false, no_hausdorff = false;
+  std::string protect_file;  ///< issue 34: --protect FILE
 };
 
 }  // namespace
@@ -55,6 +57,7 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")
       ->group("Reduction");
+  add_protect_options(sub, opt->protect_file, p);  // issue 34
   sub->add_flag("--no-hausdorff", opt->no_hausdorff, "Skip the Hausdorff measurement (and the screen sizes)")->group("Measurement");
   sub->add_option("--hausdorff-samples", opt->chain.hausdorff_samples, "Surface samples per direction of the Hausdorff measurement")
       ->check(CLI::Range(std::uint64_t{100}, std::uint64_t{100000000}))->capture_default_str()->group("Measurement");
@@ -90,6 +93,10 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
             if (in.scene.meshes.empty())
               return fail(opt->input + ": the scene has no mesh to reduce (" + std::to_string(in.scene.cameras) +
                           " cameras, " + std::to_string(in.scene.lights) + " lights)");
+            std::size_t vertices = 0;
+            for (const SceneMesh& m : in.scene.meshes) vertices += m.mesh.num_vertices();
+            if (std::string bad = load_protect_file(opt->protect_file, params.simplify, vertices); !bad.empty())
+              return fail(bad);
             const double read_seconds = clock.seconds();
             SceneLodResult chain = lod_chain_scene(in.scene, params);
             if (!chain.ok()) return fail(opt->input + ": " + chain.error);

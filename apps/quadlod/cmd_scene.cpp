@@ -1,6 +1,7 @@
 // `quadlod simplify` on scenes: FBX / glTF / Collada / … in, .glb / .fbx / .dae / OBJ / PLY / OFF
 // out, every mesh reduced (include/quadlod/lod.h, simplify_scene).
 #include "commands.h"
+#include "protect_cli.h"
 
 #include "quadlod/lod.h"
 #include "quadlod/scene.h"
@@ -12,7 +13,8 @@
 namespace quadlod::cli {
 
 int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
-                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses) {
+                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses,
+                        const std::string& protect_file) {
   SceneFormat format;
   if (!scene_format_from_path(output, format))
     return fail(output + ": unknown output format (use .obj, .ply, .off, .glb, .fbx or .dae)");
@@ -25,6 +27,10 @@ int simplify_scene_file(const std::string& input, const std::string& output, con
   const double read_seconds = clock.seconds();
   SceneSimplifyParams params;
   params.options = options;
+  // Issue 34: one weight per vertex of the scene, mesh after mesh (docs/protect.md).
+  std::size_t vertices = 0;
+  for (const SceneMesh& m : in.scene.meshes) vertices += m.mesh.num_vertices();
+  if (std::string bad = load_protect_file(protect_file, params.options, vertices); !bad.empty()) return fail(bad);
   params.per_mesh = per_mesh;
   // The skinned meshes' weights index the scene's rig, and pose_mesh with its skinning matrices
   // poses them where eval --animation does (docs/skinning.md, "Scenes"); unskinned meshes ignore them.

@@ -4,6 +4,7 @@
 #include "quadlod/io.h"
 #include "quadlod/scene.h"
 #include "skin_cli.h"
+#include "protect_cli.h"
 #include "quadlod/simplify.h"
 #include "util/progress.h"
 #ifdef QUADLOD_HTML_REPORT
@@ -32,6 +33,7 @@ struct SimplifyCliOptions {
   // "Poses": 16 meets Fig. 10's bar at 0.2 and 0.4 from the walk's frames; 4 does not at 0.2).
   SkinPoseChoice poses;
   std::uint64_t max_memory = 0;  ///< bytes; 0 = no bound
+  std::string protect_file;  ///< issue 34: --protect FILE
 };
 
 std::string format_bytes(std::uint64_t bytes) {
@@ -189,6 +191,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                   "Refuse (exit 2) an input whose estimated peak memory exceeds this (e.g. 2GiB, 512MB; 0 = no bound)")
       ->transform(CLI::AsSizeValue(false))->group("Guarantees");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
+  add_protect_options(sub, opt->protect_file, p);  // issue 34
 #ifdef QUADLOD_HTML_REPORT
   sub->add_option("--report-html", opt->report_html,
                   "Write the visual report of this run (as `quadlod report INPUT OUTPUT`)");
@@ -263,7 +266,8 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
             if (!skinned && (!native_out || !format_from_path(opt->input, input_format))) {
               if (!opt->report_html.empty())
                 return fail(opt->report_html + ": --report-html takes an OBJ, PLY or OFF input and output (use `quadlod report` on the meshes)");
-              return simplify_scene_file(opt->input, opt->output, opt->report, p, opt->per_mesh, opt->poses);
+              return simplify_scene_file(opt->input, opt->output, opt->report, p, opt->per_mesh, opt->poses,
+                                         opt->protect_file);
             }
             if (skinned && !native_out && !glb_out)
               return fail(opt->output + ": a skinned mesh is written as .glb (or .obj / .ply / .off without its skin)");
@@ -278,6 +282,8 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
               for (const Joint& j : in.rig.skeleton.joints) p.skin_joint_parents.push_back(j.parent);
             if (!in.mesh.skin.empty())
               p.skin_poses = chosen_poses(in.rig, opt->poses);
+            if (std::string bad = load_protect_file(opt->protect_file, p, in.mesh.num_vertices()); !bad.empty())
+              return fail(bad);
             const double read_seconds = clock.seconds();
             SimplifyResult r = simplify_in_place(in.mesh, p);  // the input is ours: no copy of it
             if (!r.ok()) return fail(opt->input + ": " + r.error);

@@ -52,7 +52,8 @@ Command add_batch(CLI::App& app, const GlobalOptions& global);
 /// write_scene; prints one summary line (cmd_scene.cpp). A skinned scene's meshes are reduced
 /// in `poses` of its rig as well as at the bind pose (deformation-sensitive quadrics).
 int simplify_scene_file(const std::string& input, const std::string& output, const std::string& report,
-                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses);
+                        const SimplifyOptions& options, bool per_mesh, const SkinPoseChoice& poses,
+                        const std::string& protect_file = "");  // issue 34: --protect FILE
 
 /// An option whose value is one of an enum's names (the `*_names()` of include/quadlod/
 /// simplify.h), stored into `target`: the help lists the names in their order and the default

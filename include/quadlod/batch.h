@@ -20,7 +20,9 @@ namespace quadlod {
 ///   "format": "glb" | "fbx" | …      → lod: file format (default: the input's, else glb);
 ///   "per_mesh": bool, "objective": "shape" | "paper", "time_limit": s, "threads": n,
 ///   "seed": n, "features": bool,
-///   "recover_quads": "auto" | "on" | "off" → as the CLI's options of the same names.
+///   "recover_quads": "auto" | "on" | "off" → as the CLI's options of the same names;
+///   "protect": FILE (relative to the manifest), "protect_from": "color:r" | … → as the CLI's
+///                                     --protect / --protect-from (issue 34, docs/protect.md).
 /// Unknown keys are an error of that job (a typo must not silently change the run).
 struct BatchJob {
   std::filesystem::path input;

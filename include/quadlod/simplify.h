@@ -217,6 +217,24 @@ struct SimplifyOptions {
 
   /// Progress lines on stderr (stage, percent, elapsed).
   bool progress = false;
+
+  // --- protected regions (issue 34; docs/protect.md, include/quadlod/protect.h) -----------------
+  /// One weight per input vertex in [0, 1] (empty = none, the default): 1 = the vertex keeps its
+  /// exact position and the edges between two such vertices stay; 0 < w < 1 = collapses that
+  /// move it cost more; merged vertices take the largest weight of their members.
+  std::vector<double> protect_weights;
+  /// Where the weights come from when `protect_weights` is empty: a vertex colour channel
+  /// (names "none", "color:r", "color:g", "color:b": parse_protect_channel in protect.h).
+  enum class ProtectChannel : std::uint8_t { None, Red, Green, Blue };
+  ProtectChannel protect_channel = ProtectChannel::None;
+  /// Shape objective: a vertex of weight w adds protect_strength · w · h² · |x − p|² to its
+  /// quadric (h the mean edge length, p its position): moving it by d costs like protect_strength
+  /// · w times the face planes of an area h² at distance d, so collapses go elsewhere first and
+  /// merged vertices are pulled toward it. < 0 = the measured default (default_protect_strength).
+  double protect_strength = -1.0;
+  /// Paper objective: an edge adds protect_importance · w to its importance Q(e) of Eq. 9 (1 = an
+  /// average edge), w the larger weight of its endpoints. < 0 = the measured default.
+  double protect_importance = -1.0;
 };
 
 // The choices of SimplifyOptions by name, for the CLI, manifests and Python; the names are the
@@ -259,6 +277,9 @@ struct SimplifyResult {
   /// Everything measured on the way: per-stage seconds, analysis counts, model sizes, solver
   /// status / objective / bound / gap, repair and collapse statistics.
   nlohmann::json report;
+  /// Issue 34: the protect weights of `mesh`'s vertices (each the largest of the input vertices
+  /// merged into it), for a further reduction of `mesh` (LOD chains); empty when none were given.
+  std::vector<double> protect_weights;
   bool ok() const { return error.empty(); }
 };
 
@@ -285,5 +306,8 @@ int default_swap_rounds();
 /// pass_ratio, max_passes; before the shape objective's scaling by `effort`).
 double default_pass_ratio(SimplifyOptions::Objective objective);
 int default_max_passes(SimplifyOptions::Objective objective);
+/// The measured defaults of SimplifyOptions::protect_strength / protect_importance (docs/protect.md).
+double default_protect_strength();
+double default_protect_importance();
 
 }  // namespace quadlod

@@ -13,6 +13,7 @@
 #include "quadlod/batch.h"
 #include "quadlod/io.h"
 #include "quadlod/lod.h"
+#include "quadlod/protect.h"
 #include "quadlod/scene.h"
 
 #include <algorithm>
@@ -35,7 +36,8 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
-                                               "recover_quads", "seams"};
+                                               "recover_quads", "seams",
+                                               "protect", "protect_from"};  // issue 34
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -62,6 +64,13 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
       if (!policy) return "seams must be auto or strict";
       simplify.seams = *policy;
     }
+    if (options.contains("protect_from")) {  // issue 34; "protect" (a file) is read with the input
+      const auto channel = parse_protect_channel(options["protect_from"].get<std::string>());
+      if (!channel) return "protect_from must be none, color:r, color:g or color:b";
+      simplify.protect_channel = *channel;
+    }
+    if (options.contains("protect") && !options["protect"].is_string()) return "protect must be a file name";
+    if (options.contains("protect") && options.contains("protect_from")) return "give protect or protect_from, not both";
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
     if (options.contains("format")) format = options["format"].get<std::string>();
@@ -255,6 +264,9 @@ BatchPlan plan_batch_manifest(const std::filesystem::path& manifest, const nlohm
     if (own.contains("ratio") || own.contains("faces") || own.contains("levels") || own.contains("count"))
       for (const char* key : {"ratio", "faces", "levels", "count"}) job.options.erase(key);
     for (const auto& [key, value] : own.items()) job.options[key] = value;
+    // A protect file is named relative to the manifest, like input and output (issue 34).
+    if (job.options.contains("protect") && job.options["protect"].is_string())
+      job.options["protect"] = resolve(base, job.options["protect"].get<std::string>()).string();
     plan.jobs.push_back(std::move(job));
   }
   return plan;
@@ -338,6 +350,13 @@ nlohmann::json run_batch_job(const BatchJob& job, const BatchRunParams& params) 
     const SceneReadResult in = read_scene(job.input);
     if (!in.ok()) return failed(in.error);
     if (in.scene.meshes.empty()) return failed(job.input.string() + ": the scene has no mesh to reduce");
+    if (job.options.contains("protect")) {  // issue 34: one weight per vertex of the scene, mesh after mesh
+      std::size_t vertices = 0;
+      for (const SceneMesh& m : in.scene.meshes) vertices += m.mesh.num_vertices();
+      ProtectWeightsRead weights = read_protect_weights(job.options["protect"].get<std::string>(), vertices);
+      if (!weights.ok()) return failed(weights.error);
+      simplify.protect_weights = std::move(weights.weights);
+    }
     nlohmann::json result = nlohmann::json::object();
     std::vector<std::string> written_files;
     if (is_lod(job.options)) {

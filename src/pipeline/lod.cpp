@@ -3,6 +3,7 @@
 // Hausdorff distance, the input side built once).
 #include "pipeline/lod_distance.h"
 #include "quadlod/lod.h"
+#include "quadlod/protect.h"
 #include "quadlod/metrics.h"
 
 #include <algorithm>
@@ -63,11 +64,14 @@ LodChainResult lod_chain(const PolyMesh& input, const LodChainParams& params) {
   const double diagonal = bounding_box(input).diagonal();
   const double longest = bounding_box(input).longest_side();
   const PolyMesh* previous = &input;
+  // Protect weights (issue 34) of `previous`'s vertices: level ℓ carries level ℓ − 1's.
+  std::vector<double> protect = params.simplify.protect_weights;
   std::unique_ptr<lod_detail::HausdorffToInput> to_input;  // built at the first measurement
   for (double ratio : params.ratios) {
     LodLevel level;
     level.ratio = ratio;
     SimplifyOptions options = params.simplify;
+    if (previous != &input) options.protect_weights = protect;
     options.ratio = 1.0;
     options.target_tri_equivalent =
         std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(ratio * double(result.input_tri_equivalent))));
@@ -84,6 +88,7 @@ LodChainResult lod_chain(const PolyMesh& input, const LodChainParams& params) {
       reduced.note = "already at or below the target";
     } else {
       reduced = simplify(*previous, options);
+      protect = reduced.protect_weights;
       if (!reduced.ok()) {
         result.error = reduced.error;
         result.levels.clear();
@@ -137,9 +142,38 @@ SceneLodResult lod_chain_scene(const Scene& input, const LodChainParams& params)
                  {"ngons", 0}, {"hausdorff", nullptr}, {"screen_size", nullptr}, {"seconds", 0.0},
                  {"measure_seconds", 0.0}, {"meshes", nlohmann::json::array()}};
   }
+  // Protect weights (issue 34) index the scene's vertices mesh after mesh (docs/protect.md).
+  std::vector<std::vector<double>> protect;
+  if (!params.simplify.protect_weights.empty()) {
+    std::vector<Index> sizes;
+    for (const SceneMesh& m : input.meshes) sizes.push_back(m.mesh.num_vertices());
+    if (std::string bad = split_protect_weights(params.simplify.protect_weights, sizes, protect); !bad.empty()) {
+      result.error = bad;
+      result.levels.clear();
+      return result;
+    }
+  }
+  // Weights from a colour channel: meshes without vertex colours are not protected (as simplify_scene).
+  const bool by_colour = params.simplify.protect_weights.empty() &&
+                         params.simplify.protect_channel != SimplifyOptions::ProtectChannel::None;
+  if (by_colour && std::none_of(input.meshes.begin(), input.meshes.end(),
+                                [](const SceneMesh& m) { return !m.mesh.vertex_colors.empty(); })) {
+    result.error = std::string("protect from ") + to_string(params.simplify.protect_channel) +
+                   ": no mesh of the scene has vertex colours";
+    result.levels.clear();
+    return result;
+  }
   std::uint64_t input_te = 0;
   for (std::size_t m = 0; m < input.meshes.size(); ++m) {
-    const LodChainResult chain = lod_chain(input.meshes[m].mesh, params);
+    const bool own = !protect.empty() || (by_colour && input.meshes[m].mesh.vertex_colors.empty());
+    LodChainParams mesh_params;
+    if (own) {
+      mesh_params = params;
+      if (!protect.empty()) mesh_params.simplify.protect_weights = std::move(protect[m]);
+      if (by_colour && input.meshes[m].mesh.vertex_colors.empty())
+        mesh_params.simplify.protect_channel = SimplifyOptions::ProtectChannel::None;
+    }
+    const LodChainResult chain = lod_chain(input.meshes[m].mesh, own ? mesh_params : params);
     if (!chain.ok()) {
       result.error = "mesh '" + input.meshes[m].name + "': " + chain.error;
       result.levels.clear();

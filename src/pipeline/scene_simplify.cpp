@@ -3,7 +3,9 @@
 // once however many nodes reference them, so instances are reduced once.
 #include "quadlod/lod.h"
 #include "quadlod/metrics.h"
+#include "quadlod/protect.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -19,11 +21,31 @@ SceneSimplifyResult simplify_scene(const Scene& input, const SceneSimplifyParams
   result.input_tri_equivalent = input.tri_equivalent_count();
   const SimplifyOptions& base = params.options;
   const bool absolute = base.target_tri_equivalent > 0;
+  // Protect weights (issue 34) index the scene's vertices mesh after mesh (docs/protect.md).
+  std::vector<std::vector<double>> protect;
+  if (!base.protect_weights.empty()) {
+    std::vector<Index> sizes;
+    for (const SceneMesh& m : input.meshes) sizes.push_back(m.mesh.num_vertices());
+    if (std::string bad = split_protect_weights(base.protect_weights, sizes, protect); !bad.empty()) {
+      result.error = bad;
+      return result;
+    }
+  }
   result.report = {{"per_mesh", params.per_mesh}, {"meshes", nlohmann::json::array()}};
+  // Weights from a colour channel (issue 34): meshes without vertex colours are not protected; a
+  // scene where none has them is an error, as for one mesh.
+  const bool by_colour = base.protect_weights.empty() && base.protect_channel != SimplifyOptions::ProtectChannel::None;
+  if (by_colour && std::none_of(input.meshes.begin(), input.meshes.end(),
+                                [](const SceneMesh& m) { return !m.mesh.vertex_colors.empty(); })) {
+    result.error = std::string("protect from ") + to_string(base.protect_channel) + ": no mesh of the scene has vertex colours";
+    return result;
+  }
   for (std::size_t m = 0; m < input.meshes.size(); ++m) {
     const SceneMesh& mesh = input.meshes[m];
     const std::uint64_t te = tri_equivalent_count(mesh.mesh);
     SimplifyOptions options = base;
+    if (!protect.empty()) options.protect_weights = std::move(protect[m]);
+    if (by_colour && mesh.mesh.vertex_colors.empty()) options.protect_channel = SimplifyOptions::ProtectChannel::None;
     if (absolute && !params.per_mesh) {
       // The scene's target N split by size: mesh i gets N · te_i / Σ te (at least 1).
       const double share = result.input_tri_equivalent > 0 ? double(te) / double(result.input_tri_equivalent) : 0.0;

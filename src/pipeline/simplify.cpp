@@ -8,6 +8,8 @@
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
 #include "pipeline/storage_precision.h"
+#include "pipeline/protect_pass.h"
+#include "quadlod/protect.h"
 #include "post/dual_repair.h"
 #include "post/surface_fit.h"
 #include "select/selection.h"
@@ -43,6 +45,8 @@ double default_lambda_tri() { return selection_defaults().lambda_tri; }
 double default_lambda_shape() { return ShapeSelectionParams{}.lambda_shape; }
 double default_max_triangle_share() { return ShapeSelectionParams{}.max_triangle_share; }
 int default_swap_rounds() { return ShapeSelectionParams{}.swap_rounds; }
+double default_protect_strength() { return protect_detail::kDefaultStrength; }
+double default_protect_importance() { return protect_detail::kDefaultImportance; }
 // The choices' names (simplify.h): one table per enum, in declaration order; parse, to_string
 // and the CLI's lists all read it.
 using Options = SimplifyOptions;
@@ -255,6 +259,7 @@ struct PassOutcome {
   std::string error;
   PolyMesh mesh;
   std::vector<Index> face_source;  // output face → input face of this pass (provenance)
+  std::vector<Index> vertex_map;   // input vertex → output vertex of this pass (issue 34: weights)
   nlohmann::json report;  // analysis, features, selection, dual_repair, collapse, rounds, stage_seconds
   std::string note;       // the selection's "nothing to do", when that is what happened
   std::uint64_t input_tri_equivalent = 0;
@@ -273,7 +278,7 @@ struct PassOutcome {
 PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time_limit,
                         const SimplifyOptions& options, SelectionParams sp, ShapeSelectionParams shp,
                         const DualRepairParams& dp, const ClusterCollapseParams& cp, StageLog& log,
-                        const std::string& pass_tag) {
+                        const std::string& pass_tag, const std::vector<double>& protect) {
   PassOutcome out;
   nlohmann::json& report = out.report;
 
@@ -340,6 +345,19 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
   ClusterCollapseParams pass_cp = cp;
   pass_cp.vertex_quadrics = &quadrics;
   shp.vertex_quadrics = &quadrics;
+  // Protected regions (issue 34, docs/protect.md): weights raise the quadrics the selection
+  // prices and the collapse places by (shape) or the edges' importance (paper); weight-1
+  // vertices pin the edges between them and never move (the collapse's `protected` rule).
+  std::vector<std::uint8_t> protected_vertices;
+  if (!protect.empty()) {
+    protected_vertices = protect_detail::protected_flags(protect);
+    pass_cp.protected_vertices = &protected_vertices;
+    const double strength = options.protect_strength >= 0.0 ? options.protect_strength : default_protect_strength();
+    protect_detail::add_protect_quadrics(quadrics, input, protect, strength);
+    if (options.objective == SimplifyOptions::Objective::Paper)
+      sp.extra_importance = protect_detail::protect_edge_importance(
+          conn, protect, options.protect_importance >= 0.0 ? options.protect_importance : default_protect_importance());
+  }
   if (options.features) {
     const IslandAreas islands = island_areas(input, conn, cp.face_island_area, cp.features.per_face_layout_fraction);
     pinned = feature_pins(conn, *feat,
@@ -378,6 +396,12 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     report["skin_borders"] = {{"border_edges", borders.border_edges},
                               {"related_edges", borders.related_edges},
                               {"pinned_edges", added}};
+  }
+  if (!protect.empty()) {
+    const Index pinned_protected = protect_detail::pin_protected_edges(conn, protected_vertices, pinned);
+    report["protect"] = {{"protected_vertices", std::count(protected_vertices.begin(), protected_vertices.end(), 1)},
+                         {"weighted_vertices", std::count_if(protect.begin(), protect.end(), [](double w) { return w > 0.0; })},
+                         {"pinned_edges", pinned_protected}};
   }
   std::int64_t selection_target = static_cast<std::int64_t>(target);
   std::int64_t previous_target = 0, previous_achieved = 0;
@@ -571,10 +595,13 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     best->mesh = input;
     best->face_source.resize(input.num_faces());
     std::iota(best->face_source.begin(), best->face_source.end(), Index{0});
+    best->vertex_map.resize(input.num_vertices());
+    std::iota(best->vertex_map.begin(), best->vertex_map.end(), Index{0});
     out.rounds_used = 0;
   }
   out.mesh = std::move(best->mesh);
   out.face_source = std::move(best->face_source);
+  out.vertex_map = std::move(best->vertex_map);
   out.achieved = tri_equivalent_count(out.mesh);
   return out;
 }
@@ -619,6 +646,29 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                       ? options.target_tri_equivalent
                       : static_cast<std::uint64_t>(std::llround(options.ratio * double(result.input_tri_equivalent)));
   log.set_span(double(result.input_tri_equivalent), double(result.target));
+  // Protect weights (issue 34): given, or from a colour channel; checked, then carried pass by pass.
+  std::vector<double> protect = options.protect_weights;
+  if (protect.empty() && options.protect_channel != SimplifyOptions::ProtectChannel::None) {
+    protect = protect_weights_from_colors(input, options.protect_channel);
+    if (protect.empty()) {
+      result.error = std::string("protect from ") + to_string(options.protect_channel) + ": the mesh has no vertex colours";
+      return result;
+    }
+  }
+  if (std::string bad = check_protect_weights(protect, input.num_vertices()); !bad.empty()) {
+    result.error = bad;
+    return result;
+  }
+  const bool protect_given = !protect.empty();
+  if (protect_given) {
+    report["protect"] = {
+        {"source", options.protect_weights.empty() ? to_string(options.protect_channel) : "weights"},
+        {"protected_vertices", std::count_if(protect.begin(), protect.end(), [](double w) { return w >= 1.0; })},
+        {"weighted_vertices", std::count_if(protect.begin(), protect.end(), [](double w) { return w > 0.0 && w < 1.0; })},
+        {"strength", options.protect_strength >= 0.0 ? options.protect_strength : default_protect_strength()},
+        {"importance", options.protect_importance >= 0.0 ? options.protect_importance : default_protect_importance()}};
+    // The passes' protect reports are under passes[i].report.protect.
+  }
   SelectionParams sp;
   sp.epsilon_n = options.epsilon_n;
   if (options.lambda_geo >= 0.0) sp.lambda_geo = options.lambda_geo;
@@ -769,7 +819,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     }
     cp.crossing_island_area = crossing_area;
     cp.max_vanishing_part_area = vanishing_part_area;
-    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag);
+    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag, protect);
     cp.face_island_area = nullptr;
     if (!outcome.error.empty()) {
       result.error = outcome.error;
@@ -818,6 +868,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     for (Index& f : last.face_source) f = face_origin[f];
     face_origin = std::move(last.face_source);
     current = std::move(last.mesh);
+    // Protect weights (issue 34) follow the vertices: a merged vertex takes its members' largest.
+    if (!protect.empty()) protect = protect_detail::carry_protect_weights(protect, last.vertex_map, current.num_vertices());
     // Skin weights (issue 24): by projection onto the original input after every pass, so the
     // next pass sees its joint-influence borders and the output carries weights.
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
@@ -882,6 +934,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       }
       fp.fixed_vertices = &fixed;
     }
+    // Protected vertices (issue 34) keep their exact input position: the fit does not move them.
+    if (!protect.empty()) {
+      if (fixed.empty()) fixed.assign(current.positions.size(), 0);
+      for (Index v = 0; v < current.num_vertices() && v < protect.size(); ++v)
+        if (protect[v] >= 1.0) fixed[v] = 1;
+      fp.fixed_vertices = &fixed;
+    }
     fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
     fp.measure_after = false;
     const Stopwatch fit_clock;
@@ -900,6 +959,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   }
   // Summary.
   result.mesh = std::move(current);
+  if (protect_given) result.protect_weights = std::move(protect);
   result.note = last.note;
   result.rounds_used = last.rounds_used;
   result.passes_used = static_cast<int>(report["passes"].size());
@@ -947,6 +1007,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                     static_cast<unsigned long long>(result.target), result.passes_used,
                     result.passes_used == 1 ? "" : "es", static_cast<unsigned>(last.refusals));
     result.note = std::string(text) + costliest_refusals();
+    // Issue 34: the protected vertices' pins are hard constraints too; say so.
+    if (protect_given && last.report.contains("protect"))
+      result.note += "; protect: " + std::to_string(last.report["protect"]["pinned_edges"].get<Index>()) +
+                     " edges pinned between weight-1 vertices in the last pass, which may absorb neighbours but not each other";
     if (options.seams == SimplifyOptions::SeamPolicy::Strict && options.features)
       result.note += "; with --seams strict no line merges through an island and no part vanishes (--seams auto "
                      "lets the smallest islands cross when a pass stalls)";

@@ -93,6 +93,8 @@ void Collapser::precompute() {
     }
     orientation_tol_ = std::max(0.0, params_.orientation_tolerance) * surface_->longest_side;
   }
+  if (params_.protected_vertices && params_.protected_vertices->size() == nv_)
+    protected_ = std::span<const std::uint8_t>(*params_.protected_vertices);
   features_on_ = params_.respect_features;
   if (features_on_) {
     feat_ptr_ = params_.feature_edges;
@@ -178,6 +180,16 @@ void Collapser::place(Index r) {
   ClusterTerms t;
   for (Index m : ms) t.add_vertex((*terms_)[m], mesh_.positions[m]);
   snap_edges_.clear();
+  // Issue 34: a protected member does not move; the cluster sits on it (the one with the smallest
+  // id if there are two: check_vertex refuses that cluster anyway).
+  if (!protected_.empty())
+    for (Index m : ms)
+      if (protected_[m]) {
+        pos_[r] = mesh_.positions[m];
+        ++stats_.placements_at_protected;
+        placed_round_[r] = round_;
+        return;
+      }
   if (features_on_) {
     // place_on_feature minimises the regularised quadric along the line.
     if (place_on_feature(r, regularized_quadric(t, h_, params_.placement))) {
@@ -718,6 +730,7 @@ const char* to_string(CollapseRefusal reason) {
     case CollapseRefusal::Feature: return "feature";
     case CollapseRefusal::Island: return "island";
     case CollapseRefusal::Part: return "part";
+    case CollapseRefusal::Protected: return "protected";
   }
   return "unknown";
 }
@@ -793,6 +806,7 @@ nlohmann::json to_json(const ClusterCollapseStats& s) {
       {"placements_fallback", s.placements_fallback},
       {"placements_at_feature_corner", s.placements_at_feature_corner},
       {"placements_on_feature_line", s.placements_on_feature_line},
+      {"placements_at_protected", s.placements_at_protected},
       {"line_crossings", s.line_crossings},
       {"uv_values_projected", s.uv_values_projected},
       {"normals_recomputed", s.normals_recomputed},

@@ -190,6 +190,14 @@ struct ClusterCollapseParams {
   /// output faces in the input could fall below the bound in a late pass and vanish there.
   const std::vector<double>* face_island_area = nullptr;
 
+  // --- protected regions (issue 34; docs/protect.md) -----------------------------------------
+  /// Per vertex of the mesh being collapsed (borrowed; nullptr or empty: none): 1 = protected
+  /// (weight 1). A cluster with one protected member lands exactly on it (a half-edge collapse:
+  /// the protected vertex absorbs its unprotected neighbours); a cluster with two, or with one and
+  /// a strict feature corner elsewhere, is refused (`protected`), so an edge between two protected
+  /// vertices never collapses and no protected vertex moves.
+  const std::vector<std::uint8_t>* protected_vertices = nullptr;
+
   // --- refinement -----------------------------------------------------------------------------
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
   /// from then on a refused cluster is dissolved entirely. 0: always dissolve.
@@ -216,8 +224,10 @@ enum class CollapseRefusal : std::uint8_t {
                       ///< min_kept_island_area, lose its last face
   Part,               ///< a part (connected component) of at least max_vanishing_part_area
                       ///< would lose its last face
+  Protected,          ///< issue 34: the cluster holds two protected vertices (weight 1), or one
+                      ///< and a strict feature corner, which would have to move
 };
-inline constexpr std::size_t kNumCollapseRefusals = 12;
+inline constexpr std::size_t kNumCollapseRefusals = 13;
 const char* to_string(CollapseRefusal reason);
 
 enum class ClusterCollapseStatus : std::uint8_t {
@@ -252,6 +262,7 @@ struct ClusterCollapseStats {
   Index placements_at_feature_corner = 0;   ///< clusters placed at a feature corner: their one, or
                                             ///< the best of several per-face-layout seam corners
   Index placements_on_feature_line = 0;     ///< clusters placed on the feature segments around them
+  Index placements_at_protected = 0;        ///< clusters placed on their protected member (issue 34)
   /// Output vertices that merge strict lines through an island they may cross (issue 32:
   /// crossing_island_area): clusters whose strict members are not all joined by collapsed
   /// strict edges. Each is one crossing of a line.

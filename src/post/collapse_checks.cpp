@@ -271,6 +271,23 @@ bool Collapser::features_valid(Index r) {
   return true;
 }
 
+// Issue 34 (docs/protect.md): a cluster may hold one protected vertex, which it is placed on
+// (place()), but not two (the edge or chain between them would vanish, and one of them would
+// move), nor a protected vertex and a strict feature corner (corners never move either, and the
+// cluster can sit on only one of them).
+bool Collapser::protection_valid(Index r) const {
+  Index held = 0;
+  Index corners = 0;
+  for (Index m : members(r)) {
+    if (protected_[m]) {
+      ++held;
+      continue;
+    }
+    if (feat_ptr_ && feat_ptr_->vertex_corner[m] && feat_ptr_->on_strict(m)) ++corners;
+  }
+  return held <= 1 && (held == 0 || corners == 0);
+}
+
 // A non-strict edge whose faces all lie in UV islands whose lines may merge through them.
 bool Collapser::edge_in_crossable_island(Index e) const {
   if (face_island_.empty()) return false;
@@ -287,8 +304,21 @@ bool Collapser::edge_in_crossable_island(Index e) const {
 // interior) and the members (none non-manifold).
 void Collapser::check_vertex(Index v) {
   if (features_on_ && cluster_size(v) > 1 && !features_valid(v)) blame(v, CollapseRefusal::Feature);
+  if (!protected_.empty() && cluster_size(v) > 1 && !protection_valid(v)) blame(v, CollapseRefusal::Protected);
   gather_fan(v);
   const Index nfan = static_cast<Index>(fan_.size());
+  // Issue 34: a protected vertex keeps a face. When every face around it was dropped (its
+  // neighbours merged, or its part shrank away), the clusters around it are refused.
+  if (!protected_.empty() && nfan == 0) {
+    bool holds = false;
+    for (Index m : members(v)) holds = holds || protected_[m];
+    if (holds)
+      for (Index m : members(v))
+        for (Index c : conn_.corners_at_vertex(m)) {
+          const Index f = conn_.corner_face[c];
+          for (Index k = mesh_.face_begin(f); k < mesh_.face_end(f); ++k) blame(root_of_corner(k), CollapseRefusal::Protected);
+        }
+  }
   nbr_.clear();
   for (Index i = 0; i < nfan; ++i) {
     const FanEntry& fe = fan_[i];

@@ -70,6 +70,8 @@ class Collapser {
   std::vector<std::uint8_t> side_;  // mark_crossing_side: per vertex, 1 = may anchor the placement
   std::vector<Index> side_stack_;
   bool features_valid(Index r);
+  bool protection_valid(Index r) const;  // issue 34: at most one protected member, no other strict corner
+  std::span<const std::uint8_t> protected_;  // params_.protected_vertices, or empty
   bool edge_in_crossable_island(Index e) const;
   void check_feature_edges(Index v);
   std::vector<std::pair<Index, std::uint8_t>> line_edges_;  // check_feature_edges: {w, kinds}

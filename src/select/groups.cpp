@@ -63,6 +63,13 @@ std::uint64_t predicted_new_triangles(const PolyMesh& mesh, const Connectivity& 
   return n;
 }
 
+std::vector<double> selection_importance(const PolyMesh& mesh, const Connectivity& conn, const SelectionParams& params) {
+  std::vector<double> importance = edge_importance(mesh, conn, params.importance_cap);
+  if (params.extra_importance.size() == importance.size())
+    for (std::size_t e = 0; e < importance.size(); ++e) importance[e] += params.extra_importance[e];
+  return importance;
+}
+
 namespace select_detail {
 
 Groups make_groups(const Connectivity& conn, const AnalysisResult& analysis,
@@ -312,7 +319,7 @@ FreeComponents free_components(const Groups& g, const GroupConstraints& gc, cons
 Prepared prepare(const PolyMesh& mesh, const Connectivity& conn, const AnalysisResult& analysis,
                  const SelectionParams& params, const std::vector<std::uint8_t>& edge_kept) {
   Prepared p;
-  p.importance = edge_importance(mesh, conn, params.importance_cap);
+  p.importance = selection_importance(mesh, conn, params);
   p.groups = make_groups(conn, analysis, p.importance, params);
   p.gc = make_group_constraints(mesh, conn, p.groups, analysis, params);
   p.fg = make_face_groups(mesh, conn, p.groups);

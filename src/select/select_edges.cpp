@@ -42,7 +42,7 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
   }
 
   Stopwatch prepare_clock;
-  const std::vector<double> importance = edge_importance(mesh, conn, params.importance_cap);
+  const std::vector<double> importance = selection_importance(mesh, conn, params);
   const Groups groups = make_groups(conn, analysis, importance, params);
   for (double q : importance) result.baseline_objective -= params.lambda_edge * q;
   const GroupConstraints gc = make_group_constraints(mesh, conn, groups, analysis, params);

@@ -68,6 +68,10 @@ struct SelectionParams {
   /// round (§3.3.2 guarantees), so the next selection collapses other chords instead. Pinning
   /// an edge keeps its whole group (Eq. 4).
   std::vector<std::uint8_t> keep_edges;
+  /// Issue 34 (docs/protect.md): added to each edge's importance Q(e) (after the cap), one entry
+  /// per Connectivity edge; empty = none. The pipeline passes protect_importance · w, w the larger
+  /// protect weight of the edge's endpoints, so the Eq. 9 objective prefers to keep such edges.
+  std::vector<double> extra_importance;
 
   /// The MIP solve. time_limit_seconds <= 0 skips the solver and returns the greedy selection.
   std::string solver = "cbc";
@@ -330,6 +334,8 @@ SelectionResult select_edges(const PolyMesh& mesh, const Connectivity& conn,
 /// summed at both endpoints) of collapsing the edge to the best point on it, divided by the
 /// mean over all edges with a positive error and capped at `cap`. All zero on a flat mesh.
 std::vector<double> edge_importance(const PolyMesh& mesh, const Connectivity& conn, double cap);
+/// edge_importance() plus params.extra_importance (issue 34), what the selection prices.
+std::vector<double> selection_importance(const PolyMesh& mesh, const Connectivity& conn, const SelectionParams& params);
 
 /// N' of Eq. 1 for a given edge selection: Σ_f max(0, kept edges of f − 2). This is the count
 /// the ILP optimises; the mesh produced by the collapse may differ slightly (see §3.3).

@@ -4,7 +4,8 @@
 
 installs the add-on zip, enables it, builds a torus with UVs and two materials (and a vertex
 group), runs "Quad-dominant LOD" with two levels and checks the LODs: collection, counts, quad
-fraction, UV layer, material slots and indices, vertex group, the original untouched; then that
+fraction, UV layer, material slots and indices, vertex group, the original untouched; a "Protect"
+vertex group whose vertices keep their exact positions (issue 34); then that
 a bad mesh gives an error report, not a crash; and that `import quadlod` is the module. Run it
 with BLENDER_USER_SCRIPTS / BLENDER_USER_CONFIG pointing at a fresh directory
 (tests/blender/run_blender_tests.py does) so the user's Blender setup is not touched.
@@ -103,6 +104,35 @@ def main(zip_path):
         metrics = quadlod.evaluate(mesh_dict(obj.data), mesh_dict(lod.data), samples=20000)
         check(metrics["seams_torn"] == 0 and metrics["uv_islands_merged"] == 0,
               f"LOD{k}: {metrics['seams_torn']} seams torn, {metrics['uv_islands_merged']} UV islands merged")
+
+    # Issue 34: the "Protect" vertex group reaches the reduction. A ring whose group holds the
+    # vertices with x > 0.6 at weight 1: both LODs keep each of them at its exact position (and
+    # the first LOD's weights carry them into the second); without the group they move.
+    bpy.ops.mesh.primitive_torus_add(major_segments=48, minor_segments=16, location=(0, 0, -5))
+    ring = bpy.context.active_object
+    ring.name = "Guarded"
+    keep = ring.vertex_groups.new(name="Keep")
+    keep_ids = [v.index for v in ring.data.vertices if v.co.x > 0.6]
+    keep.add(keep_ids, 1.0, "REPLACE")
+    kept = {tuple(ring.data.vertices[i].co) for i in keep_ids}
+    check(0.1 * len(ring.data.vertices) < len(kept) < 0.3 * len(ring.data.vertices), f"{len(kept)} vertices in group Keep")
+    bpy.ops.object.select_all(action="DESELECT")
+    ring.select_set(True)
+    bpy.context.view_layer.objects.active = ring
+    check(bpy.ops.object.quadlod_lod(levels=2, ratio=0.5, protect_group="Keep") == {"FINISHED"},
+          "operator with a Protect vertex group")
+    for k in (1, 2):
+        lod = bpy.data.objects.get(f"Guarded_LOD{k}")
+        out = {tuple(v.co) for v in lod.data.vertices} if lod else set()
+        missing = len(kept - out)
+        check(lod is not None and missing == 0, f"Guarded LOD{k}: {missing} of {len(kept)} protected vertices moved")
+        check(lod is not None and lod["quadlod_report"].get("protected_vertices") == len(kept),
+              f"Guarded LOD{k}: the report counts {lod['quadlod_report'].get('protected_vertices') if lod else None} protected")
+    ring.name = "Unguarded"
+    check(bpy.ops.object.quadlod_lod(levels=1, ratio=0.5) == {"FINISHED"}, "operator without a Protect group")
+    plain = bpy.data.objects.get("Unguarded_LOD1")
+    moved = len(kept - {tuple(v.co) for v in plain.data.vertices}) if plain else 0
+    check(moved > len(kept) // 4, f"without the group {moved} of {len(kept)} of those vertices move")
 
     # Custom split normals travel: a cylinder with custom normals (all pointing up, so they are
     # recognisably not the ones Blender would compute) gets LODs with custom normals pointing up.

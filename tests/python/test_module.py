@@ -305,3 +305,32 @@ def test_same_output_as_the_cli_on_corpus_meshes_with_uvs(tmp_path, name):
     np.testing.assert_allclose(r["vertices"], expected["vertices"], rtol=0, atol=1e-6)
     (got,), (want,) = r["uvs"].values(), expected["uvs"].values()
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-6)
+
+
+def test_protect_keeps_weight_one_vertices_exactly():
+    """Issue 34 (docs/protect.md): protect= weights — the weight-1 vertices (a band of the torus)
+    come out at their exact input positions, the output's weights follow its vertices, and a bad
+    array is the library's one-line error."""
+    vertices, quads, _, _ = torus(32, 16)
+    weights = (vertices[:, 0] > 0.9).astype(float)  # a band of 1 on the far side of the torus
+    weights[(vertices[:, 1] > 0.8)] = 0.5
+    assert 0.1 < np.mean(weights == 1.0) < 0.3
+    r = quadlod.simplify(vertices, quads, ratio=0.3, protect=weights)
+    out = {tuple(p) for p in r["vertices"]}
+    protected = vertices[weights == 1.0]
+    assert all(tuple(p) in out for p in protected)
+    assert len(r["protect"]) == len(r["vertices"])
+    assert int(np.sum(r["protect"] == 1.0)) == len(protected)
+    assert abs(r["report"]["achieved"] - r["report"]["target"]) <= 0.03 * r["report"]["target"]
+    assert r["report"]["protect"]["protected_vertices"] == len(protected)
+    # Without weights the band is reduced like the rest.
+    plain = {tuple(p) for p in quadlod.simplify(vertices, quads, ratio=0.3)["vertices"]}
+    assert sum(tuple(p) not in plain for p in protected) > len(protected) // 4
+    with pytest.raises(quadlod.QuadlodError, match="protect weight of vertex 3 is 2"):
+        bad = np.zeros(len(vertices))
+        bad[3] = 2.0
+        quadlod.simplify(vertices, quads, ratio=0.3, protect=bad)
+    with pytest.raises(quadlod.QuadlodError, match="protect weights for"):
+        quadlod.simplify(vertices, quads, ratio=0.3, protect=np.zeros(5))
+    with pytest.raises(TypeError, match="protect"):
+        quadlod.simplify(vertices, quads, ratio=0.3, protect=np.zeros((5, 2)))

@@ -8,7 +8,11 @@ operator made. What travels with the mesh (docs/blender.md):
     normals (when the mesh has them) go through the core, which protects seams and borders;
   * vertex groups are not carried by the core: each LOD vertex takes the weights of the nearest
     vertex of the source mesh (the collapse places merged vertices on the input surface);
-  * smooth shading: all faces smooth when every input face is.
+  * smooth shading: all faces smooth when every input face is;
+  * a vertex group chosen as "Protect" (as Decimate takes one) gives the protect weights of
+    issue 34 (docs/protect.md): weight 1 keeps the vertex exactly and the edges between such
+    vertices, between 0 and 1 collapses there cost more; vertices outside the group weigh 0.
+    Each LOD level carries the previous level's weights (the core returns them).
 Invoked from the UI the operator is modal: one LOD level per timer tick, so the status bar and
 the progress indicator redraw between levels. Called from a script (EXEC), it runs all levels
 at once. Errors become reports (and a cancelled operator), never an exception out of Blender.
@@ -16,7 +20,7 @@ at once. Errors become reports (and a cancelled operator), never an exception ou
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from . import _core  # the package loaded it (see _load_core in __init__.py)
 
@@ -51,6 +55,11 @@ def _settings_annotations():
         effort=EnumProperty(name="Effort", items=EFFORT_ITEMS, default="DEFAULT"),
         time_limit=FloatProperty(name="Time limit (s)", description="MIP budget per level in seconds (effort ILP)",
                                  default=5.0, min=0.0, max=600.0),
+        # Issue 34: the protect weights from a vertex group (by name; objects without it: none).
+        protect_group=StringProperty(
+            name="Protect", default="",
+            description="Vertex group whose weights protect vertices: 1 = kept exactly (with the edges between "
+                        "such vertices), between 0 and 1 = reduced later; empty = none"),
     )
 
 
@@ -105,6 +114,19 @@ def _vertex_weights(obj):
         for g in v.groups:
             if g.group in weights:
                 weights[g.group][v.index] = g.weight
+    return weights
+
+
+def _protect_weights(obj, group_name):
+    """(V,) weights of the vertex group `group_name` (0 outside it), or None without that group."""
+    group = obj.vertex_groups.get(group_name) if group_name else None
+    if group is None:
+        return None
+    weights = np.zeros(len(obj.data.vertices))
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == group.index:
+                weights[v.index] = min(1.0, max(0.0, g.weight))
     return weights
 
 
@@ -230,6 +252,7 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
                 raise _core.QuadlodError(f"{obj.name}: the mesh has no faces")
             weights = _vertex_weights(obj)
             state = dict(arrays=arrays, previous=None, weights=weights,
+                         protect=_protect_weights(obj, self.protect_group),
                          # only the vertex-group transfer needs the source positions as tuples
                          positions=[tuple(v) for v in arrays["vertices"]] if weights else None,
                          size=int(np.sum(arrays["faces"][1] - 2)),
@@ -238,9 +261,14 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
             self._state[obj.name] = state
         src = state["arrays"] if state["previous"] is None else state["previous"]
         faces = src["faces"] if state["previous"] is None else (src["faces"], src["face_sizes"])
+        options = self._options()
+        # Protect weights: the group's for LOD1, then the previous level's (they follow the vertices).
+        protect = state["protect"] if state["previous"] is None else src.get("protect")
+        if protect is not None:
+            options.update(protect=protect)
         level = _core.simplify(src["vertices"], faces, faces_target=self._target(state["size"], k),
                                uvs=src.get("uvs"), normals=src.get("normals"),
-                               materials=src.get("materials"), **self._options())
+                               materials=src.get("materials"), **options)
         state["previous"] = level
         me = _build_mesh(f"{obj.name}_LOD{k}", level, obj, state["all_smooth"])
         lod = bpy.data.objects.new(f"{obj.name}_LOD{k}", me)
@@ -249,6 +277,8 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
         _copy_vertex_groups(obj, lod, state["weights"], state["positions"])
         lod["quadlod_report"] = {key: level["report"][key] for key in
                                  ("input_tri_equivalent", "target", "achieved", "quads", "triangles", "ngons")}
+        if "protect" in level["report"]:
+            lod["quadlod_report"]["protected_vertices"] = level["report"]["protect"]["protected_vertices"]
         self._made.append(lod)
         self._done += 1
 
@@ -337,6 +367,11 @@ class QUADLOD_PT_panel(bpy.types.Panel):
         layout.prop(settings, "ratio")
         layout.prop(settings, "levels")
         layout.prop(settings, "protect_uv_seams")
+        active = context.active_object
+        if active is not None and active.type == "MESH":  # as Decimate picks its vertex group
+            layout.prop_search(settings, "protect_group", active, "vertex_groups", text="Protect")
+        else:
+            layout.prop(settings, "protect_group", text="Protect")
         layout.prop(settings, "effort")
         row = layout.row()
         row.enabled = settings.effort == "ILP"
