@@ -22,6 +22,7 @@ struct BatchCliOptions {
   std::string recover_quads;
   std::string seams;
   int threads = -1;
+  std::string symmetry;  // issue 34
 };
 
 }  // namespace
@@ -49,6 +50,9 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--seams", opt->seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->check(CLI::IsMember({"auto", "strict"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
+  // --- symmetry (issue 34; docs/symmetry.md) ---
+  sub->add_option("--symmetry", opt->symmetry, "Mirror-symmetric reduction: auto, x, y, z or off (as in simplify)")
+      ->check(CLI::IsMember({"auto", "x", "y", "z", "off"}));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
   sub->add_option("--shard", opt->shard,
                   "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
@@ -72,6 +76,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (!opt->seams.empty()) defaults["seams"] = opt->seams;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
+            if (!opt->symmetry.empty()) defaults["symmetry"] = opt->symmetry;
             const bool folder = std::filesystem::is_directory(opt->source);
             if (folder && opt->output_dir.empty()) {
               std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");

@@ -2,6 +2,7 @@
 // a chain of LODs, each reduced from the previous one (include/quadlod/lod.h), one file per
 // level plus DIR/lods.json (docs/lod.md).
 #include "commands.h"
+#include "symmetry_cli.h"
 
 #include "quadlod/lod.h"
 #include "quadlod/scene.h"
@@ -53,6 +54,10 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                     "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->group("Reduction");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
+  // --- symmetry (issue 34; docs/symmetry.md) ---
+  add_choice_option(sub, "--symmetry", p.symmetry, symmetry_names(),
+                    "Mirror-symmetric reduction: auto, x, y, z or off (as in simplify; each level about the plane of its input)")
+      ->group("Reduction");
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")
       ->group("Reduction");
   sub->add_flag("--no-hausdorff", opt->no_hausdorff, "Skip the Hausdorff measurement (and the screen sizes)")->group("Measurement");
@@ -112,6 +117,8 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                           level["triangles"].get<unsigned long long>(), level["ngons"].get<unsigned long long>(),
                           num(level["hausdorff"]), num(level["screen_size"]), level["seconds"].get<double>(),
                           files[l].string().c_str());
+              for (const nlohmann::json& mesh : level["meshes"])
+                print_symmetry_line(mesh, "lod" + std::to_string(l + 1) + ": ");
             }
             std::printf("lod: %zu levels, read %.2f s, chain %.2f s, write %.2f s\n", chain.levels.size(), read_seconds,
                         chain.seconds, written.report["write_seconds"].get<double>());

@@ -217,6 +217,24 @@ struct SimplifyOptions {
 
   /// Progress lines on stderr (stage, percent, elapsed).
   bool progress = false;
+
+  // --- symmetry (issue 34; docs/symmetry.md) ----------------------------------------------------
+  /// Mirror-symmetric reduction about a bbox-centred axis plane. Auto: the plane among x, y, z
+  /// whose mirror matches the most vertices, if it matches at least symmetry_min_matched of
+  /// them; X / Y / Z: that plane, if it does; Off: none. The selection then collapses every
+  /// segment and single edge together with its mirror image, each cluster is placed as the
+  /// reflection of its mirror cluster (on the plane when it is its own mirror), the collapse's
+  /// refusals are made symmetric, the surface fit moves pairs together, and the output's mirror
+  /// pairs are exact reflections. Attributes (UVs, normals, colours, skin weights) still come
+  /// from each side's own input vertices. A mesh that is not symmetric within the tolerance is
+  /// reduced without symmetry, with a note (report: `symmetry`).
+  enum class Symmetry : std::uint8_t { Auto, X, Y, Z, Off };
+  Symmetry symmetry = Symmetry::Off;
+  /// A vertex's mirror partner lies within this fraction of the bbox diagonal of its reflection.
+  double symmetry_tolerance = 1e-4;
+  /// The share of vertices (paired or on the plane) a plane needs to count as a mirror plane; the
+  /// unmatched rest is reduced without a mirror constraint.
+  double symmetry_min_matched = 0.99;
 };
 
 // The choices of SimplifyOptions by name, for the CLI, manifests and Python; the names are the
@@ -245,6 +263,10 @@ std::vector<std::pair<std::string, SimplifyOptions::SelectionStrategy>> selectio
 std::optional<SimplifyOptions::SolverBackend> parse_solver_backend(const std::string& name);
 const char* to_string(SimplifyOptions::SolverBackend backend);
 std::vector<std::pair<std::string, SimplifyOptions::SolverBackend>> solver_backend_names();
+/// Symmetry (issue 34): "auto", "x", "y", "z", "off".
+std::optional<SimplifyOptions::Symmetry> parse_symmetry(const std::string& name);
+const char* to_string(SimplifyOptions::Symmetry symmetry);
+std::vector<std::pair<std::string, SimplifyOptions::Symmetry>> symmetry_names();
 
 struct SimplifyResult {
   PolyMesh mesh;       ///< the reduced mesh (the input unchanged when nothing is to do)

@@ -35,7 +35,8 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
-                                               "recover_quads", "seams"};
+                                               "recover_quads", "seams",
+                                               "symmetry"};  // issue 34
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -61,6 +62,12 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
       const auto policy = parse_seam_policy(options["seams"].get<std::string>());
       if (!policy) return "seams must be auto or strict";
       simplify.seams = *policy;
+    }
+    // Symmetry (issue 34; docs/symmetry.md).
+    if (options.contains("symmetry")) {
+      const auto symmetry = parse_symmetry(options["symmetry"].get<std::string>());
+      if (!symmetry) return "symmetry must be auto, x, y, z or off";
+      simplify.symmetry = *symmetry;
     }
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
