@@ -21,6 +21,8 @@ void print_symmetry_line(const nlohmann::json& report, const std::string& prefix
               prefix.c_str(), axis.c_str(), axis.c_str(), s.value("centre", 0.0), 100.0 * s.value("matched_fraction", 0.0),
               static_cast<unsigned long long>(s.value("on_plane_vertices", 0ull)),
               static_cast<unsigned long long>(s.value("unmatched_vertices", 0ull)));
+  if (s.value("strict_edges_mirrored_fraction", 1.0) < 1.0)
+    std::printf("; %.1f %% of the strict lines' edges mirrored", 100.0 * s["strict_edges_mirrored_fraction"].get<double>());
   if (s.contains("output_paired_vertices"))
     std::printf("; output: %llu paired, %llu on the plane, %llu unmatched",
                 static_cast<unsigned long long>(s.value("output_paired_vertices", 0ull)),

@@ -6,8 +6,9 @@
 # OUTDIR/suzanne_subdiv_mirror.obj: Suzanne, Catmull–Clark once, its x < 0 half deleted and
 #   mirrored back (so the halves are exact reflections, not equal up to the subdivision's rounding).
 # OUTDIR/creature_mirror.obj: a UV sphere whose right half is dented at random (seeded) and grows
-#   two extruded horns, mirrored; smart-UV-projected after the mirror, so its UV islands are not
-#   mirror images (what the attribute rule of docs/symmetry.md is about).
+#   two extruded horns, smart-UV-projected, mirrored (the modifier mirrors the UVs as well).
+# OUTDIR/creature_mirror_smartuv.obj: the same mesh unwrapped again after the mirror, so its UV
+#   islands are not mirror images (what "Attributes" in docs/symmetry.md is about).
 # Both exported as quads and triangles (no triangulation), with UVs; Blender's -Z forward / Y up
 # keeps x, the mirror axis.
 import bmesh
@@ -24,8 +25,17 @@ def clear():
     bpy.ops.object.delete()
 
 
-def mirror_half(obj):
-    """Deletes the x < 0 half and applies a Mirror modifier across x (clipping, merge)."""
+def smart_uv(obj):
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="SELECT")
+    bpy.ops.uv.smart_project(island_margin=0.01)
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def mirror_half(obj, unwrap_half=False):
+    """Deletes the x < 0 half and applies a Mirror modifier across x (clipping, merge); with
+    unwrap_half, the half is smart-UV-projected first, so the modifier mirrors its UVs too."""
     bpy.context.view_layer.objects.active = obj
     bpy.ops.object.mode_set(mode="EDIT")
     bm = bmesh.from_edit_mesh(obj.data)
@@ -35,6 +45,8 @@ def mirror_half(obj):
             v.co.x = 0.0  # exactly on the plane
     bmesh.update_edit_mesh(obj.data)
     bpy.ops.object.mode_set(mode="OBJECT")
+    if unwrap_half:
+        smart_uv(obj)
     m = obj.modifiers.new("Mirror", "MIRROR")
     m.use_axis[0] = True
     m.use_clip = True
@@ -84,9 +96,7 @@ for centre in ((0.55, 0.0, 0.8), (0.9, -0.3, -0.2)):
             -sum((v.co for v in verts), mathutils.Vector()) / len(verts)), verts=verts)
 bmesh.update_edit_mesh(cr.data)
 bpy.ops.object.mode_set(mode="OBJECT")
-mirror_half(cr)
-bpy.ops.object.mode_set(mode="EDIT")
-bpy.ops.mesh.select_all(action="SELECT")
-bpy.ops.uv.smart_project(island_margin=0.01)
-bpy.ops.object.mode_set(mode="OBJECT")
+mirror_half(cr, unwrap_half=True)
 export(cr, "creature_mirror.obj")
+smart_uv(cr)  # unwrapped again as a whole: islands that are not mirror images
+export(cr, "creature_mirror_smartuv.obj")

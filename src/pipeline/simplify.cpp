@@ -1092,6 +1092,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"symmetry", to_string(options.symmetry)},
       {"symmetry_tolerance", options.symmetry_tolerance},
       {"symmetry_min_matched", options.symmetry_min_matched},
+      {"symmetry_min_mirrored_lines", options.symmetry_min_mirrored_lines},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +

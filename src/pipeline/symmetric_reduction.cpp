@@ -1,7 +1,11 @@
 // Symmetric reduction: see symmetric_reduction.h (issue 34, docs/symmetry.md).
 #include "pipeline/symmetric_reduction.h"
 
+#include "mesh/features.h"
+
 #include <cstdio>
+#include <optional>
+#include <tuple>
 
 namespace quadlod {
 
@@ -16,6 +20,29 @@ int requested_axis(SimplifyOptions::Symmetry s) {
 }
 }  // namespace
 
+namespace {
+// The share of the strict lines' edges (UV seams, material borders, boundaries) whose mirror edge
+// is strict too; `strict` gets their count.
+double mirrored_line_fraction(const PolyMesh& input, const Connectivity& conn, const FeatureEdges& feat,
+                              const VertexMirror& m, Index& strict) {
+  const std::vector<Index> em = mirror_edges(conn, m);
+  Index mirrored = 0;
+  strict = 0;
+  for (Index e = 0; e < conn.num_edges; ++e) {
+    if (!feat.is_strict(e)) continue;
+    ++strict;
+    mirrored += em[e] != kInvalidIndex && feat.is_strict(em[e]);
+  }
+  (void)input;
+  return strict ? double(mirrored) / double(strict) : 1.0;
+}
+}  // namespace
+
+// The plane: each axis asked for (auto: all three) is matched (detect_symmetry); among those that
+// reach min_matched, auto keeps the one whose strict lines are mirrored (at least
+// min_mirrored_lines), then the most matched vertices, then the most mirrored lines, then the
+// fewest vertices on the plane, then x, y, z. A cylinder with one UV seam is symmetric about two
+// planes through its axis; only the one through the seam mirrors the seam.
 SymmetrySetup setup_symmetry(const PolyMesh& input, const SimplifyOptions& options) {
   SymmetrySetup out;
   out.report = {{"requested", to_string(options.symmetry)}, {"axis", "none"}};
@@ -24,14 +51,63 @@ SymmetrySetup setup_symmetry(const PolyMesh& input, const SimplifyOptions& optio
   dp.tolerance = options.symmetry_tolerance;
   dp.min_matched_fraction = options.symmetry_min_matched;
   const int axis = requested_axis(options.symmetry);
-  SymmetryDetection d = detect_symmetry(input, axis, dp);
-  out.tolerance = d.tolerance;
   out.report["tolerance"] = options.symmetry_tolerance;
   out.report["min_matched"] = options.symmetry_min_matched;
-  out.report["best_axis"] = axis_name(d.best_axis);
-  out.report["best_matched_fraction"] = d.best_fraction;
-  if (d.symmetric()) {
-    const VertexMirror& m = d.mirror;
+  std::optional<Connectivity> conn;
+  std::optional<FeatureEdges> feat;
+  if (options.features) {
+    conn = build_connectivity(input);
+    FeatureParams fp;
+    fp.hard_angle_deg = options.hard_angle_deg;
+    feat = find_feature_edges(input, *conn, fp);
+  }
+  struct Candidate {
+    VertexMirror mirror;
+    double lines = 1.0;
+    Index strict = 0;
+  };
+  std::optional<Candidate> best;
+  auto key = [&](const Candidate& c) {
+    return std::tuple(c.lines >= options.symmetry_min_mirrored_lines, c.mirror.matched_fraction(), c.lines,
+                      -double(c.mirror.on_plane));
+  };
+  int best_axis = -1;
+  double best_fraction = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    if (axis >= 0 && a != axis) continue;
+    SymmetryDetection d = detect_symmetry(input, a, dp);
+    out.tolerance = d.tolerance;
+    if (d.best_axis >= 0 && (best_axis < 0 || d.best_fraction > best_fraction)) {
+      best_axis = d.best_axis;
+      best_fraction = d.best_fraction;
+    }
+    if (!d.symmetric()) continue;
+    Candidate c{std::move(d.mirror)};
+    if (feat) c.lines = mirrored_line_fraction(input, *conn, *feat, c.mirror, c.strict);
+    if (!best || key(c) > key(*best)) best = std::move(c);
+  }
+  out.report["best_axis"] = axis_name(best_axis);
+  out.report["best_matched_fraction"] = best_fraction;
+  if (best) {
+    const VertexMirror& m = best->mirror;
+    if (feat) {
+      out.report["strict_edges"] = best->strict;
+      out.report["strict_edges_mirrored_fraction"] = best->lines;
+    }
+    // Auto only: where the lines are not mirrored, each side's lines would bind both sides
+    // (docs/symmetry.md, "Attributes"); an explicit axis mirrors anyway.
+    if (axis < 0 && best->lines < options.symmetry_min_mirrored_lines) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "mirror-symmetric about the %s plane, but its UV seams, material borders and boundaries are not "
+                    "(%.1f %% of %u strict edges mirrored, %.0f %% needed): reduced without symmetry (--symmetry %s "
+                    "mirrors anyway, each side's lines binding both)",
+                    axis_name(m.plane.axis), 100.0 * best->lines, static_cast<unsigned>(best->strict),
+                    100.0 * options.symmetry_min_mirrored_lines, axis_name(m.plane.axis));
+      out.note = text;
+      out.report["note"] = out.note;
+      return out;
+    }
     out.plane = m.plane;
     out.report["axis"] = axis_name(m.plane.axis);
     out.report["centre"] = m.plane.centre;
@@ -47,7 +123,7 @@ SymmetrySetup setup_symmetry(const PolyMesh& input, const SimplifyOptions& optio
   std::snprintf(text, sizeof text,
                 "not mirror-symmetric %s within %g of the diagonal (best: %s, %.1f %% of the vertices matched, %.1f %% needed); "
                 "reduced without symmetry",
-                where.c_str(), options.symmetry_tolerance, axis_name(d.best_axis), 100.0 * d.best_fraction,
+                where.c_str(), options.symmetry_tolerance, axis_name(best_axis), 100.0 * best_fraction,
                 100.0 * options.symmetry_min_matched);
   out.note = text;
   out.report["note"] = out.note;
