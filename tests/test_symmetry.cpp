@@ -93,6 +93,16 @@ TEST(Symmetry, MatchesPairsOnPlaneVerticesAndDuplicates) {
   EXPECT_DOUBLE_EQ(m.matched_fraction(), 7.0 / 8.0);
 }
 
+// Hostile coordinates (eval reads any file): no cast overflow, such points match nothing.
+TEST(Symmetry, NonFiniteAndHugeCoordinatesMatchNothing) {
+  const double nan = std::nan("");
+  const std::vector<Vec3> p = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(nan, 0, 0), Vec3(1e300, 0, 0), Vec3(INFINITY, 1, 0)};
+  const VertexMirror m = match_mirror_vertices(p, MirrorPlane{0, 0.0}, 1e-6);
+  EXPECT_EQ(m.pairs, 2u);
+  EXPECT_EQ(m.unmatched, 3u);
+  EXPECT_DOUBLE_EQ(mirrored_vertex_fraction(p, MirrorPlane{0, 0.0}, 1e-6), 2.0 / 5.0);
+}
+
 TEST(Symmetry, MirrorEdgesOfAGridAreItsReflections) {
   const PolyMesh g = bumped_grid(6, 4);
   const Connectivity conn = build_connectivity(g);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
 
 namespace quadlod::cli {
 
@@ -108,6 +109,7 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             if (!written.ok()) return fail(written.error);
             const auto num = [](const nlohmann::json& v) { return v.is_null() ? std::nan("") : v.get<double>(); };
+            std::set<std::string> noted;  // meshes whose symmetry note was printed (issue 34)
             for (std::size_t l = 0; l < chain.levels.size(); ++l) {
               const nlohmann::json& level = written.report["levels"][l];
               std::printf("lod%zu: ratio %.4g, target %llu, achieved %llu, %llu quads, %llu tris, %llu n-gons, "
@@ -117,8 +119,13 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                           level["triangles"].get<unsigned long long>(), level["ngons"].get<unsigned long long>(),
                           num(level["hausdorff"]), num(level["screen_size"]), level["seconds"].get<double>(),
                           files[l].string().c_str());
-              for (const nlohmann::json& mesh : level["meshes"])
+              // The plane of each mesh; a note once per mesh (the next level is reduced from this
+              // one, and is not symmetric either).
+              for (const nlohmann::json& mesh : level["meshes"]) {
+                const bool note = mesh.contains("symmetry") && mesh["symmetry"].contains("note");
+                if (note && !noted.insert(mesh.value("name", std::string())).second) continue;
                 print_symmetry_line(mesh, "lod" + std::to_string(l + 1) + ": ");
+              }
             }
             std::printf("lod: %zu levels, read %.2f s, chain %.2f s, write %.2f s\n", chain.levels.size(), read_seconds,
                         chain.seconds, written.report["write_seconds"].get<double>());

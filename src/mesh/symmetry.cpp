@@ -22,13 +22,16 @@ const char* axis_name(int axis) {
 
 namespace {
 
+bool finite(const Vec3& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
+
 // Points bucketed in cubes of side `cell`; a query within `cell` of a point looks at the 27 cubes
 // around it.
 class HashGrid {
  public:
   HashGrid(const std::vector<Vec3>& points, double cell) : points_(points), inv_(1.0 / cell) {
     cells_.reserve(points.size());
-    for (Index i = 0; i < Index(points.size()); ++i) cells_[key(cell_of(points[i]))].push_back(i);
+    for (Index i = 0; i < Index(points.size()); ++i)
+      if (finite(points[i])) cells_[key(cell_of(points[i]))].push_back(i);
   }
   // Calls visit(i) for every point within the 27 cubes around p (a superset of those within `cell`).
   template <class F>
@@ -44,9 +47,11 @@ class HashGrid {
   }
 
  private:
+  // Clamped before the cast (a coordinate 1e30 times the cell would overflow it); cells that far
+  // out only share buckets.
+  static std::int64_t cell(double v) { return std::int64_t(std::clamp(std::floor(v), -4e18, 4e18)); }
   std::array<std::int64_t, 3> cell_of(const Vec3& p) const {
-    return {std::int64_t(std::floor(p.x() * inv_)), std::int64_t(std::floor(p.y() * inv_)),
-            std::int64_t(std::floor(p.z() * inv_))};
+    return {cell(p.x() * inv_), cell(p.y() * inv_), cell(p.z() * inv_)};
   }
   static std::uint64_t key(const std::array<std::int64_t, 3>& c) {
     // 21 bits per axis (wrapping): collisions only merge buckets, the distance test decides.
@@ -57,8 +62,6 @@ class HashGrid {
   double inv_;
   std::unordered_map<std::uint64_t, std::vector<Index>> cells_;
 };
-
-bool finite(const Vec3& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
 
 }  // namespace
 
