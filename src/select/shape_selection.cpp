@@ -624,17 +624,18 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     std::vector<std::pair<std::size_t, std::size_t>> filled;  // per chunk: begin, end of its writes
     std::mutex filled_mutex;
     std::atomic<std::int64_t> evaluations = 0;
-    auto price = [&](std::size_t begin, std::size_t end, Scratch* scratch) {
+    // One mirror scratch per worker (its `seen` has an entry per edge), made on first use.
+    std::vector<MirrorScratch> mirror_scratch(mirror ? std::max<std::size_t>(1, thread_count(params.threads)) : 0);
+    auto price = [&](std::size_t begin, std::size_t end, Scratch* scratch, std::size_t worker) {
       std::size_t out = begin;
       std::int64_t evaluated = 0;
-      MirrorScratch own_mirror;  // this chunk's
       for (std::size_t i = begin; i < end; ++i) {
         const Index id = Index(i);
         if (id < nu ? bool(units.g.fixed[id]) : !single_edge(id - nu)) continue;
         Index one = id >= nu ? id - nu : 0;
         std::span<const Index> edges = id < nu ? units.of(id) : std::span<const Index>(&one, 1);
         if (mirror) {
-          edges = with_mirror(edges, own_mirror);
+          edges = with_mirror(edges, mirror_scratch[worker]);
           if (edges.empty()) continue;
         }
         const Move m = scratch ? state.evaluate(edges, *scratch) : state.evaluate(edges);
@@ -651,10 +652,10 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
         n, params.threads, params.min_parallel_candidates, params.pricing_chunks_per_thread,
         [&](std::size_t i) { return i < std::size_t(nu) ? double(units.of(Index(i)).size()) : 1.0; },
         [&](std::size_t begin, std::size_t end, std::size_t worker) {
-          if (worker == 0) return price(begin, end, nullptr);  // the state's own scratch
+          if (worker == 0) return price(begin, end, nullptr, worker);  // the state's own scratch
           Scratch& own = scratch[worker - 1];
           if (own.root_token.empty()) own = state.make_scratch();
-          price(begin, end, &own);
+          price(begin, end, &own, worker);
         });
     std::sort(filled.begin(), filled.end());
     std::size_t size = 0;
