@@ -107,6 +107,9 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"protect_from", set_choice(&SimplifyOptions::protect_channel, "protect_from", protect_channel_names())},
       {"protect_strength", set_field(&SimplifyOptions::protect_strength)},
       {"protect_importance", set_field(&SimplifyOptions::protect_importance)},
+      // --- symmetry (issue 34; docs/symmetry.md) ---
+      {"symmetry", set_choice(&SimplifyOptions::symmetry, "symmetry", symmetry_names())},
+      {"symmetry_tolerance", set_field(&SimplifyOptions::symmetry_tolerance)},
   };
   return table;
 }
@@ -128,6 +131,7 @@ void check_ranges(const SimplifyOptions& o) {
   in(o.max_rounds, 1, 64, "max_rounds");
   in(o.surface_fit_iterations, 0, 100, "surface_fit");
   in(o.surface_fit_vertex_weight, 0.0, 100.0, "surface_fit_vertex_weight");
+  in(o.symmetry_tolerance, 1e-9, 0.1, "symmetry_tolerance");  // issue 34
 }
 
 SimplifyOptions options_from_kwargs(const py::kwargs& kwargs) {

@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 using namespace quadlod::testing;
 namespace fs = std::filesystem;
@@ -71,6 +73,69 @@ TEST_F(CliTest, SeamsStrictKeepsEveryPartAndSaysWhyItStopped) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.out.find("seams must be auto or strict"), std::string::npos) << run.out;
   EXPECT_EQ(nlohmann::json::parse(run_cli("info --json " + (dir / "out" / "strict.obj").string(), dir).out)["faces"], 50);
+}
+
+// Issue 34: --symmetry reaches simplify, lod, batch (manifests) and eval's `symmetry` metric. A
+// grid bent symmetrically about x = 0, and the same grid with one row lifted (not symmetric).
+std::string bent_grid_obj(bool symmetric) {
+  std::string text;
+  const int n = 12, m = 8;
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = -1.0 + 2.0 * i / n, y = -0.5 + 1.0 * j / m;
+      const double z = 0.3 * std::exp(-3.0 * (x * x + y * y)) + 0.1 * y + (!symmetric && j == 2 && i < 4 ? 0.05 : 0.0);
+      char line[96];
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", x, y, z);
+      text += line;
+    }
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i + 1;
+      text += "f " + std::to_string(a) + " " + std::to_string(a + 1) + " " + std::to_string(a + n + 2) + " " +
+              std::to_string(a + n + 1) + "\n";
+    }
+  return text;
+}
+
+TEST_F(CliTest, SymmetryReachesSimplifyLodBatchAndEval) {
+  const std::string d = dir.string() + "/";
+  write_text(dir / "sym.obj", bent_grid_obj(true));
+  write_text(dir / "asym.obj", bent_grid_obj(false));
+  CliRun run = run_cli("-q simplify " + d + "sym.obj -o " + d + "sym.out.obj --ratio 0.4 --symmetry x --report " + d + "sym.json", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("symmetry: mirror about the x plane (x = 0): 100.00 % of the input's vertices matched"), std::string::npos)
+      << run.out;
+  const auto report = nlohmann::json::parse(slurp(dir / "sym.json"));
+  EXPECT_EQ(report["symmetry"]["axis"], "x");
+  EXPECT_EQ(report["options"]["symmetry"], "x");
+  const auto eval = nlohmann::json::parse(run_cli("-q eval " + d + "sym.obj " + d + "sym.out.obj --json --samples 1000", dir).out);
+  EXPECT_EQ(eval["symmetry"]["axis"], "x");
+  EXPECT_EQ(eval["symmetry"]["output_mirrored_fraction"], 1.0);
+  // Not symmetric: one line of note, reduced as with off.
+  run = run_cli("-q simplify " + d + "asym.obj -o " + d + "asym.auto.obj --ratio 0.4 --symmetry auto", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("note: not mirror-symmetric about any bbox-centred axis plane"), std::string::npos) << run.out;
+  ASSERT_EQ(run_cli("-q simplify " + d + "asym.obj -o " + d + "asym.off.obj --ratio 0.4 --symmetry off", dir).exit_code, 0);
+  EXPECT_EQ(slurp(dir / "asym.auto.obj"), slurp(dir / "asym.off.obj"));
+  const CliRun bad = run_cli("simplify " + d + "sym.obj -o " + d + "x.obj --ratio 0.4 --symmetry sideways", dir);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--symmetry: sideways not in {auto,x,y,z,off}"), std::string::npos) << bad.err;
+  for (const char* sub : {"simplify", "lod"})
+    EXPECT_NE(run_cli(std::string(sub) + " --help", dir).out.find("--symmetry TEXT:{auto,x,y,z,off}"), std::string::npos) << sub;
+  // lod: each level about its input's plane, on stdout and in lods.json.
+  run = run_cli("-q lod " + d + "sym.obj -o " + d + "lods --levels 0.5,0.25 --format obj --symmetry auto", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("lod2: symmetry: mirror about the x plane"), std::string::npos) << run.out;
+  const auto lods = nlohmann::json::parse(slurp(dir / "lods" / "lods.json"));
+  EXPECT_EQ(lods["levels"][1]["meshes"][0]["symmetry"]["axis"], "x") << lods.dump();
+  // batch: the manifest's option, and a bad value refused.
+  write_text(dir / "jobs.jsonl",
+             "{\"input\": \"sym.obj\", \"output\": \"out/sym.obj\", \"ratio\": 0.4, \"symmetry\": \"x\"}\n"
+             "{\"input\": \"sym.obj\", \"output\": \"out/bad.obj\", \"ratio\": 0.4, \"symmetry\": \"w\"}\n");
+  run = run_cli("-q batch " + d + "jobs.jsonl", dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.out.find("symmetry must be auto, x, y, z or off"), std::string::npos) << run.out;
+  EXPECT_EQ(slurp(dir / "out" / "sym.obj"), slurp(dir / "sym.out.obj"));
 }
 
 }  // namespace

@@ -111,7 +111,9 @@ TEST_P(SceneRoundTrip, SimplifyCliKeepsTheSceneTogether) {
   const std::string ext = GetParam();
   const fs::path in = dir / ("scene" + ext), out = dir / ("reduced" + ext);
   ASSERT_TRUE(write_scene(make_test_scene(), in).ok());
-  const CliRun run = run_cli("-q simplify '" + in.string() + "' -o '" + out.string() + "' --ratio 0.5", dir);
+  // Symmetry off: the file's vertex order differs from memory's, and on this 48-quad grid one tie
+  // taken differently moves a pair of mirrored collapses (13 points of quad fraction, issue 34).
+  const CliRun run = run_cli("-q simplify '" + in.string() + "' -o '" + out.string() + "' --ratio 0.5 --symmetry off", dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   // A .glb holds triangles only, so its meshes have their pairs joined into quads first (quad
   // recovery, docs/scenes.md) and the summary says so; FBX and Collada keep their quads.
@@ -146,6 +148,7 @@ TEST_P(SceneRoundTrip, SimplifyCliKeepsTheSceneTogether) {
     // (the file's vertex order may differ, so within 5 points rather than exactly).
     SceneSimplifyParams params;
     params.options.ratio = 0.5;
+    params.options.symmetry = SimplifyOptions::Symmetry::Off;
     const SceneSimplifyResult direct = simplify_scene(make_test_scene(), params);
     ASSERT_TRUE(direct.ok()) << direct.error;
     const FaceTally t = tally(grid->mesh), ref = tally(direct.scene.meshes[0].mesh);

@@ -585,6 +585,7 @@ TEST(SimplifyCorpus, AMissedTargetFallsBackToTheGreedySelection) {
   SimplifyOptions single = quick(0.2);
   single.max_passes = 1;
   single.max_rounds = 1;
+  single.symmetry = SimplifyOptions::Symmetry::Off;  // the scenario as measured (Suzanne is symmetric: issue 34)
   const SimplifyResult s = simplify(in.mesh, single);
   ASSERT_TRUE(s.ok()) << s.error;
   ASSERT_TRUE(s.report.contains("fallback"));
@@ -628,6 +629,7 @@ TEST(SimplifyCorpus, NoEdgeIsShrunkToAPoint) {
   for (SimplifyOptions o : {with_old_lambdas({}), SimplifyOptions{}}) {
     o.ratio = 0.2;
     o.time_limit_seconds = 0.0;
+    o.symmetry = SimplifyOptions::Symmetry::Off;  // the scenario as measured (the teeth are symmetric: issue 34)
     const SimplifyResult r = simplify(in.mesh, o);
     ASSERT_TRUE(r.ok()) << r.error;
     EXPECT_GT(shortest_edge(r.mesh), zero) << to_string(o.objective);

@@ -23,6 +23,7 @@ struct BatchCliOptions {
   std::string seams;
   std::string protect_from;  // issue 34
   int threads = -1;
+  std::string symmetry;  // issue 34
 };
 
 }  // namespace
@@ -50,6 +51,9 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--seams", opt->seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->check(CLI::IsMember({"auto", "strict"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
+  // --- symmetry (issue 34; docs/symmetry.md) ---
+  sub->add_option("--symmetry", opt->symmetry, "Mirror-symmetric reduction: auto, x, y, z or off (as in simplify)")
+      ->check(CLI::IsMember({"auto", "x", "y", "z", "off"}));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
   sub->add_option("--protect-from", opt->protect_from,
                   "Protect weights from a vertex colour channel (as in simplify; a manifest line's \"protect\": FILE names a weight file)")
@@ -77,6 +81,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
             if (!opt->protect_from.empty()) defaults["protect_from"] = opt->protect_from;  // issue 34
+            if (!opt->symmetry.empty()) defaults["symmetry"] = opt->symmetry;
             const bool folder = std::filesystem::is_directory(opt->source);
             if (folder && opt->output_dir.empty()) {
               std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");

@@ -8,6 +8,7 @@
 #include "quadlod/animation_metrics.h"
 #include "quadlod/io.h"
 #include "skin_cli.h"
+#include "symmetry_cli.h"
 #include "quadlod/metrics.h"
 #include "util/progress.h"
 
@@ -152,6 +153,7 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
             const MeshStats validity = compute_stats(out.mesh, build_connectivity(out.mesh));
             const MeshStats input_validity = compute_stats(in.mesh, build_connectivity(in.mesh));
             if (!global.quiet) std::fprintf(stderr, "eval: metrics in %.2f s\n", r.seconds);
+            const nlohmann::json symmetry = symmetry_metric(in.mesh, out.mesh);  // issue 34
             if (opt->json) {
               nlohmann::json j = to_json(r);
               j["input"] = opt->input;
@@ -159,6 +161,7 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
               j["tri_equivalent_in"] = r.counts_in.tri_equivalent;
               j["tri_equivalent_out"] = r.counts_out.tri_equivalent;
               j["validity"] = validity_json(validity, input_validity);
+              j["symmetry"] = symmetry;
               std::printf("%s\n", j.dump(2).c_str());
               return kExitOk;
             }
@@ -200,6 +203,11 @@ Command add_eval(CLI::App& app, const GlobalOptions& global) {
                         validity.degenerate_faces, validity.duplicate_faces,
                         static_cast<unsigned long long>(r.flipped_faces),
                         static_cast<unsigned long long>(r.flipped_faces_kept));
+            if (symmetry.contains("output_mirrored_fraction"))
+              std::printf("  symmetry            %s plane: %.2f %% of input vertices matched, %.2f %% of output vertices "
+                          "mirrored (within %g of the input diagonal)\n",
+                          symmetry["axis"].get<std::string>().c_str(), 100.0 * symmetry["input_matched_fraction"].get<double>(),
+                          100.0 * symmetry["output_mirrored_fraction"].get<double>(), symmetry["tolerance"].get<double>());
             return kExitOk;
           }};
 }

@@ -2,6 +2,7 @@
 // a chain of LODs, each reduced from the previous one (include/quadlod/lod.h), one file per
 // level plus DIR/lods.json (docs/lod.md).
 #include "commands.h"
+#include "symmetry_cli.h"
 
 #include "protect_cli.h"
 #include "quadlod/lod.h"
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
 
 namespace quadlod::cli {
 
@@ -55,6 +57,10 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                     "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->group("Reduction");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
+  // --- symmetry (issue 34; docs/symmetry.md) ---
+  add_choice_option(sub, "--symmetry", p.symmetry, symmetry_names(),
+                    "Mirror-symmetric reduction: auto, x, y, z or off (as in simplify; each level about the plane of its input)")
+      ->group("Reduction");
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")
       ->group("Reduction");
   add_protect_options(sub, opt->protect_file, p);  // issue 34
@@ -110,6 +116,7 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
             for (const std::string& w : written.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
             if (!written.ok()) return fail(written.error);
             const auto num = [](const nlohmann::json& v) { return v.is_null() ? std::nan("") : v.get<double>(); };
+            std::set<std::string> noted;  // meshes whose symmetry note was printed (issue 34)
             for (std::size_t l = 0; l < chain.levels.size(); ++l) {
               const nlohmann::json& level = written.report["levels"][l];
               std::printf("lod%zu: ratio %.4g, target %llu, achieved %llu, %llu quads, %llu tris, %llu n-gons, "
@@ -119,6 +126,13 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
                           level["triangles"].get<unsigned long long>(), level["ngons"].get<unsigned long long>(),
                           num(level["hausdorff"]), num(level["screen_size"]), level["seconds"].get<double>(),
                           files[l].string().c_str());
+              // The plane of each mesh; a note once per mesh (the next level is reduced from this
+              // one, and is not symmetric either).
+              for (const nlohmann::json& mesh : level["meshes"]) {
+                const bool note = mesh.contains("symmetry") && mesh["symmetry"].contains("note");
+                if (note && !noted.insert(mesh.value("name", std::string())).second) continue;
+                print_symmetry_line(mesh, "lod" + std::to_string(l + 1) + ": ");
+              }
             }
             std::printf("lod: %zu levels, read %.2f s, chain %.2f s, write %.2f s\n", chain.levels.size(), read_seconds,
                         chain.seconds, written.report["write_seconds"].get<double>());

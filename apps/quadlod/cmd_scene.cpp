@@ -2,6 +2,7 @@
 // out, every mesh reduced (include/quadlod/lod.h, simplify_scene).
 #include "commands.h"
 #include "protect_cli.h"
+#include "symmetry_cli.h"
 
 #include "quadlod/lod.h"
 #include "quadlod/scene.h"
@@ -69,6 +70,9 @@ int simplify_scene_file(const std::string& input, const std::string& output, con
   if (joined > 0)
     std::printf("quads: all-triangle meshes had %llu pairs joined into quads first (--recover-quads off keeps them)\n",
                 static_cast<unsigned long long>(joined));
+  // Symmetry (issue 34): the plane of each mesh, or why none.
+  for (const auto& m : r.report["meshes"])
+    if (m.contains("simplify")) print_symmetry_line(m["simplify"], m.value("name", std::string()) + ": ");
   if (format == SceneFormat::Glb) std::printf("note: glTF holds triangles only: %s has its polygons triangulated\n", output.c_str());
   return kExitOk;
 }

@@ -1,5 +1,6 @@
 // `quadlod simplify INPUT -o OUTPUT (--ratio R | --faces N) ...`: the whole pipeline.
 #include "commands.h"
+#include "symmetry_cli.h"
 
 #include "quadlod/io.h"
 #include "quadlod/scene.h"
@@ -190,6 +191,15 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--max-memory", opt->max_memory,
                   "Refuse (exit 2) an input whose estimated peak memory exceeds this (e.g. 2GiB, 512MB; 0 = no bound)")
       ->transform(CLI::AsSizeValue(false))->group("Guarantees");
+  // --- symmetry (issue 34; docs/symmetry.md) ---
+  add_choice_option(sub, "--symmetry", p.symmetry, symmetry_names(),
+                    "Mirror-symmetric reduction about a bbox-centred axis plane: auto (the plane the input is symmetric "
+                    "about, if any), x, y, z, or off; an input not symmetric within the tolerance gets a note and is "
+                    "reduced without symmetry")
+      ->group("Features");
+  sub->add_option("--symmetry-tolerance", p.symmetry_tolerance,
+                  "Largest distance of a vertex's mirror partner from its reflection, relative to the bbox diagonal")
+      ->check(CLI::Range(1e-9, 0.1))->capture_default_str()->group("Features");
   sub->add_option("--report", opt->report, "Write a JSON report (per-stage times, solver statistics)");
   add_protect_options(sub, opt->protect_file, p);  // issue 34
 #ifdef QUADLOD_HTML_REPORT
@@ -341,6 +351,7 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                           static_cast<unsigned long long>(seams["line_crossings"].get<std::uint64_t>()), faces,
                           seams["vanishing_part_area"].get<double>() > 0.0 ? "; parts that small may vanish" : "");
             }
+            print_symmetry_line(rep);
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;
           }};

@@ -37,7 +37,8 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
                                                "recover_quads", "seams",
-                                               "protect", "protect_from"};  // issue 34
+                                               "protect", "protect_from",
+                                               "symmetry"};  // issue 34
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -71,6 +72,12 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
     }
     if (options.contains("protect") && !options["protect"].is_string()) return "protect must be a file name";
     if (options.contains("protect") && options.contains("protect_from")) return "give protect or protect_from, not both";
+    // Symmetry (issue 34; docs/symmetry.md).
+    if (options.contains("symmetry")) {
+      const auto symmetry = parse_symmetry(options["symmetry"].get<std::string>());
+      if (!symmetry) return "symmetry must be auto, x, y, z or off";
+      simplify.symmetry = *symmetry;
+    }
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
     if (options.contains("format")) format = options["format"].get<std::string>();

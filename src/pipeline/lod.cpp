@@ -197,6 +197,9 @@ SceneLodResult lod_chain_scene(const Scene& input, const LodChainParams& params)
           (j["screen_size"].is_null() || level.screen_size < j["screen_size"].get<double>()))
         j["screen_size"] = level.screen_size;
       nlohmann::json mesh_json = level_json(level);
+      // Symmetry (issue 34): the plane each level was reduced about, when it was asked for.
+      if (level.report.contains("symmetry") && level.report["symmetry"].value("requested", "off") != "off")
+        mesh_json["symmetry"] = level.report["symmetry"];
       mesh_json["name"] = input.meshes[m].name;
       mesh_json["input_tri_equivalent"] = chain.input_tri_equivalent;
       j["meshes"].push_back(std::move(mesh_json));

@@ -5,11 +5,13 @@
 #include "mesh/connectivity.h"
 #include "mesh/quad_recovery.h"
 #include "mesh/features.h"
+#include "mesh/symmetry.h"
 #include "mesh/validation.h"
 #include "post/cluster_collapse.h"
 #include "pipeline/storage_precision.h"
 #include "pipeline/protect_pass.h"
 #include "quadlod/protect.h"
+#include "pipeline/symmetric_reduction.h"
 #include "post/dual_repair.h"
 #include "post/surface_fit.h"
 #include "select/selection.h"
@@ -119,6 +121,20 @@ std::optional<Options::SolverBackend> parse_solver_backend(const std::string& na
 const char* to_string(Options::SolverBackend backend) {
   static const auto names = solver_backend_names();
   return name_of(names, backend);
+}
+
+// Symmetry (issue 34; docs/symmetry.md).
+std::vector<std::pair<std::string, Options::Symmetry>> symmetry_names() {
+  return {{"auto", Options::Symmetry::Auto},
+          {"x", Options::Symmetry::X},
+          {"y", Options::Symmetry::Y},
+          {"z", Options::Symmetry::Z},
+          {"off", Options::Symmetry::Off}};
+}
+std::optional<Options::Symmetry> parse_symmetry(const std::string& name) { return parse_by_name(symmetry_names(), name); }
+const char* to_string(Options::Symmetry symmetry) {
+  static const auto names = symmetry_names();
+  return name_of(names, symmetry);
 }
 
 // Passes of the shape objective: on 12 corpus meshes (docs/shape_objective.md, "Passes"), pass
@@ -270,15 +286,25 @@ struct PassOutcome {
   std::uint64_t predicted = 0;
   std::int64_t selection_target = 0;
   Index feature_pins = 0;
+  int symmetry_reruns = 0;  // extra collapses that made refusals symmetric (issue 34)
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
 };
+
+// Symmetry (issue 34): collapses after the first of a round, each on the intersection of the
+// last one's collapsed edges with their mirror images, until a refusal's split is mirrored too
+// (collapse_symmetric). Each asks for a subset of the last, so refusals fall fast: on the meshes
+// of docs/symmetry.md at most one per round was needed, except with --symmetry x on
+// assimp_suzanne_subdiv (its seams 69 % mirrored), which reached this cap once. Beyond it the
+// round keeps what it has, and the next pass re-matches the pairs.
+constexpr int kSymmetryReruns = 6;
 
 // One pass of the paper's pipeline on `input`, aiming at `target` triangle-equivalents, with
 // `time_limit` seconds of MIP budget for its first round.
 PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time_limit,
                         const SimplifyOptions& options, SelectionParams sp, ShapeSelectionParams shp,
                         const DualRepairParams& dp, const ClusterCollapseParams& cp, StageLog& log,
-                        const std::string& pass_tag, const std::vector<double>& protect) {
+                        const std::string& pass_tag, const std::vector<double>& protect,
+                        const SymmetrySetup& symmetry) {
   PassOutcome out;
   nlohmann::json& report = out.report;
 
@@ -403,6 +429,18 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
                          {"weighted_vertices", std::count_if(protect.begin(), protect.end(), [](double w) { return w > 0.0; })},
                          {"pinned_edges", pinned_protected}};
   }
+  // Symmetry (issue 34): this pass's mirror maps; the pins are made symmetric (a seam on one side
+  // pins its mirror edges too), the selection mirrors every move, the collapse mirrors placements.
+  const PassMirror mirror = pass_mirror(input, conn, symmetry);
+  const bool mirrored = symmetry.active();
+  if (mirrored) {
+    if (!pinned.empty()) keep_mirrored(pinned, mirror);
+    shp.edge_mirror = &mirror.edges;
+    pass_cp.mirror = &mirror.vertices;
+    report["symmetry"] = {{"paired_vertices", mirror.vertices.pairs},
+                          {"on_plane_vertices", mirror.vertices.on_plane},
+                          {"unmatched_vertices", mirror.vertices.unmatched}};
+  }
   std::int64_t selection_target = static_cast<std::int64_t>(target);
   std::int64_t previous_target = 0, previous_achieved = 0;
   std::optional<ClusterCollapseResult> best;
@@ -442,6 +480,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
     } else {
       selection = select_edges(input, conn, analysis, static_cast<std::uint64_t>(selection_target), sp);
     }
+    if (mirrored) keep_mirrored(selection.edge_kept, mirror);  // the paper objective's selection
     const double select_seconds = clock.seconds();
     out.seconds_select += select_seconds;
     log.done(2, "select", select_seconds,
@@ -450,15 +489,20 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
                  tag);
 
     clock = Stopwatch();
-    const DualRepairResult repaired =
+    DualRepairResult repaired =
         repair_dual_graph(input, conn, analysis.polychords, selection.edge_kept, dp);
+    if (mirrored) keep_mirrored(repaired.edge_kept, mirror);
     out.seconds_dual += clock.seconds();
     log.done(3, "dual", clock.seconds(),
              std::to_string(repaired.stats.super_faces_found) + " super-faces, " +
                  std::to_string(repaired.stats.splits) + " splits" + tag);
 
     clock = Stopwatch();
-    ClusterCollapseResult collapsed = collapse_clusters(input, conn, repaired.edge_kept, pass_cp);
+    int reruns = 0;
+    ClusterCollapseResult collapsed =
+        mirrored ? collapse_symmetric(input, conn, repaired.edge_kept, pass_cp, mirror, kSymmetryReruns, reruns)
+                 : collapse_clusters(input, conn, repaired.edge_kept, pass_cp);
+    out.symmetry_reruns += reruns;
     if (collapsed.status != ClusterCollapseStatus::Ok) {
       out.error = collapsed.error;
       return out;
@@ -496,6 +540,7 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
          std::int64_t(collapsed.stats.tri_equivalent_out) - std::int64_t(collapsed.stats.tri_equivalent_wanted)},
         {"newly_pinned_edges", newly_pinned},
         {"undoing", undoing},
+        {"symmetry_reruns", reruns},
         {"seconds_select", select_seconds},
         {"time_limit_seconds", sp.solve.time_limit_seconds},
         // Where the selection's time went (the budget covers all of it; docs/formulation.md).
@@ -660,6 +705,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     return result;
   }
   const bool protect_given = !protect.empty();
+  // Symmetry (issue 34): the plane, chosen once on the run's input (auto declines one-sided protection).
+  SymmetrySetup symmetry = setup_symmetry(input, options, protect);
   if (protect_given) {
     report["protect"] = {
         {"source", options.protect_weights.empty() ? to_string(options.protect_channel) : "weights"},
@@ -783,6 +830,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   PassOutcome last;
   nlohmann::json passes = nlohmann::json::array();
   double seconds_analysis = 0.0, seconds_select = 0.0, seconds_dual = 0.0, seconds_collapse = 0.0;
+  int symmetry_reruns = 0;  // issue 34: over every pass run
   // Passes after a stall (SeamPolicy::Auto) come on top of max_passes, at most this many: the far
   // LODs of UV-heavy meshes stall late, after the planned passes, and each stall needs a pass to
   // use its larger crossing bound (tpsdemo_door_reactor at 0.05 ran out of passes at +10.6 %).
@@ -819,13 +867,14 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     }
     cp.crossing_island_area = crossing_area;
     cp.max_vanishing_part_area = vanishing_part_area;
-    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag, protect);
+    PassOutcome outcome = reduce_pass(*pass_input, pass_target, pass_time, options, sp, shp, dp, cp, log, tag, protect, symmetry);
     cp.face_island_area = nullptr;
     if (!outcome.error.empty()) {
       result.error = outcome.error;
       return result;
     }
     seconds_analysis += outcome.seconds_analysis;
+    symmetry_reruns += outcome.symmetry_reruns;
     seconds_select += outcome.seconds_select;
     seconds_dual += outcome.seconds_dual;
     seconds_collapse += outcome.seconds_collapse;
@@ -895,6 +944,19 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"dual", seconds_dual},
                              {"collapse", seconds_collapse}};
 
+  // Symmetry (issue 34): the output's mirror pairs, by position (the collapse placed them as exact
+  // reflections; kept input vertices are mirrored within the tolerance), made exact; the fit
+  // below moves each pair together.
+  std::optional<VertexMirror> output_mirror;
+  std::vector<std::uint8_t> protected_out;  // protect weight 1 (issue 34): never moved
+  if (symmetry.active() && pass_input == &current) {
+    output_mirror = match_mirror_vertices(current.positions, symmetry.plane, symmetry.tolerance);
+    if (!protect.empty()) {
+      protected_out.assign(current.num_vertices(), 0);
+      for (Index v = 0; v < current.num_vertices(); ++v) protected_out[v] = protect[v] >= 1.0;
+    }
+    symmetry.report["output_snap"] = symmetrize_positions(current.positions, *output_mirror, &protected_out);
+  }
   // The final fit to the input surface (surface_fit.h): after the last pass, so it moves the
   // vertices the output keeps; the weights follow the moved vertices.
   if (options.surface_fit_iterations > 0 && result.target < result.input_tri_equivalent &&
@@ -943,6 +1005,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     }
     fp.surface = surface ? &*surface : nullptr;  // the run's input BVH
     fp.measure_after = false;
+    if (output_mirror) fp.mirror = &*output_mirror;
     const Stopwatch fit_clock;
     const SurfaceFitResult fit = fit_to_surface(input, current, fp);
     report["surface_fit"] = {{"iterations", fp.iterations},
@@ -957,6 +1020,15 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
     report["stage_seconds"]["fit"] = fit_clock.seconds();
   }
+  if (output_mirror) {
+    // The fit moved pairs together; one more exact write costs nothing and guards the rule.
+    symmetrize_positions(current.positions, *output_mirror, &protected_out);
+    symmetry.report["output_paired_vertices"] = output_mirror->pairs;
+    symmetry.report["output_on_plane_vertices"] = output_mirror->on_plane;
+    symmetry.report["output_unmatched_vertices"] = output_mirror->unmatched;
+    symmetry.report["collapse_reruns"] = symmetry_reruns;
+  }
+  report["symmetry"] = symmetry.report;
   // Summary.
   result.mesh = std::move(current);
   if (protect_given) result.protect_weights = std::move(protect);
@@ -1088,6 +1160,10 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"max_triangle_share", shp.max_triangle_share},
       {"swap_rounds", shp.swap_rounds},
       {"triangle_penalty", shp.triangle_penalty},
+      {"symmetry", to_string(options.symmetry)},
+      {"symmetry_tolerance", options.symmetry_tolerance},
+      {"symmetry_min_matched", options.symmetry_min_matched},
+      {"symmetry_min_mirrored_lines", options.symmetry_min_mirrored_lines},
   };
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +
@@ -1162,7 +1238,8 @@ std::string check_choices(const SimplifyOptions& options) {
                           check_choice("recover_quads", options.recover_quads, quad_recovery_names()),
                           check_choice("solver strategy", options.strategy, selection_strategy_names()),
                           check_choice("solver", options.solver, solver_backend_names()),
-                          check_choice("seams", options.seams, seam_policy_names())})
+                          check_choice("seams", options.seams, seam_policy_names()),
+                          check_choice("symmetry", options.symmetry, symmetry_names())})
     if (!bad.empty()) return bad;
   return {};
 }

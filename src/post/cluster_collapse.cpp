@@ -20,6 +20,7 @@
 // public functions. The class is declared in collapser.h; its checks are in collapse_checks.cpp,
 // its UV-island guarantee in collapse_islands.cpp, its output in collapse_output.cpp.
 #include "post/cluster_collapse.h"
+#include "mesh/symmetry.h"
 
 #include "geometry/bvh.h"
 #include "geometry/quadric.h"
@@ -180,6 +181,10 @@ void Collapser::place(Index r) {
   ClusterTerms t;
   for (Index m : ms) t.add_vertex((*terms_)[m], mesh_.positions[m]);
   snap_edges_.clear();
+  if (params_.mirror) {
+    placed_now_.push_back(r);
+    placed_on_feature_[r] = 0;
+  }
   // Issue 34: a protected member does not move; the cluster sits on it (the one with the smallest
   // id if there are two: check_vertex refuses that cluster anyway).
   if (!protected_.empty())
@@ -194,6 +199,7 @@ void Collapser::place(Index r) {
     // place_on_feature minimises the regularised quadric along the line.
     if (place_on_feature(r, regularized_quadric(t, h_, params_.placement))) {
       placed_round_[r] = round_;
+      if (params_.mirror) placed_on_feature_[r] = 1;
       return;
     }
   }
@@ -222,6 +228,67 @@ void Collapser::place(Index r) {
   stats_.placements_fallback += pl.fallback;
   pos_[r] = pl.position;
   placed_round_[r] = round_;
+}
+
+// --- symmetry (issue 34) -------------------------------------------------------------------------
+
+// The root of r's mirror cluster when it is one: every member's partner in it, the same size.
+// r itself for a cluster that is its own mirror; kInvalidIndex otherwise.
+Index Collapser::mirror_root(Index r) const {
+  const std::vector<Index>& partner = params_.mirror->partner;
+  const Index first = partner[members(r)[0]];
+  if (first == kInvalidIndex) return kInvalidIndex;
+  const Index r2 = root_[first];
+  if (cluster_size(r2) != cluster_size(r)) return kInvalidIndex;
+  for (Index m : members(r))
+    if (partner[m] == kInvalidIndex || root_[partner[m]] != r2) return kInvalidIndex;
+  return r2;
+}
+
+// Mirrored placements (docs/symmetry.md, "Placement"): the clusters placed this round, and their
+// mirror clusters, end as exact reflections of each other; a cluster that is its own mirror sits
+// on the plane. The quadrics of a mirror pair are mirror images, so the two placements differ by
+// rounding only — except where the input's attributes are not mirrored (a UV seam on one side
+// only places that side's cluster on its line): then the side on a feature line is reflected.
+bool Collapser::holds_protected(Index r) const {
+  if (protected_.empty()) return false;
+  for (Index m : members(r))
+    if (protected_[m]) return true;
+  return false;
+}
+
+void Collapser::mirror_placements(std::vector<Index>* dirty) {
+  const MirrorPlane& plane = params_.mirror->plane;
+  for (Index r : placed_now_) {
+    if (root_[r] != r || cluster_size(r) < 2 || placed_round_[r] != round_) continue;
+    const Index r2 = mirror_root(r);
+    if (r2 == kInvalidIndex) continue;
+    // A protected vertex keeps its exact input position (issue 34, docs/protect.md) over its
+    // mirror: a cluster holding one, or whose mirror holds one, is not reflected.
+    if (holds_protected(r) || holds_protected(r2)) continue;
+    if (r2 == r) {
+      pos_[r][plane.axis] = plane.centre;
+      continue;
+    }
+    const bool now2 = placed_round_[r2] == round_;
+    Index from = r;
+    if (now2) {
+      if (placed_on_feature_[r] != placed_on_feature_[r2]) from = placed_on_feature_[r] ? r : r2;
+      else from = std::min(r, r2);
+    }
+    const Index to = from == r ? r2 : r;
+    pos_[to] = plane.reflect(pos_[from]);
+    if (now2 || !dirty) continue;
+    placed_round_[to] = round_;
+    for (Index m : members(to))
+      for (Index c : conn_.corners_at_vertex(m)) {
+        const Index f = conn_.corner_face[c];
+        if (face_dirty_token_[f] == dirty_token_) continue;
+        face_dirty_token_[f] = dirty_token_;
+        dirty->push_back(f);
+      }
+  }
+  placed_now_.clear();
 }
 
 // Feature-constrained placement (issue 7). A cluster with exactly one feature corner sits on it.
@@ -604,8 +671,13 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
   face_pinched_.assign(nf_, 0);
 
   round_ = 0;
+  if (params_.mirror) {
+    placed_now_.clear();
+    placed_on_feature_.assign(nv_, 0);
+  }
   for (Index v = 0; v < nv_; ++v)
     if (root_[v] == v && cluster_size(v) > 1) place(v);
+  if (params_.mirror) mirror_placements(nullptr);
   std::vector<Index> dirty;
   for (Index f = 0; f < nf_; ++f) {
     rebuild_face(f);
@@ -658,6 +730,7 @@ void Collapser::run(const std::vector<std::uint8_t>& edge_kept, ClusterCollapseR
           next_dirty_.push_back(f);
         }
     }
+    if (params_.mirror) mirror_placements(&next_dirty_);
     for (Index f : next_dirty_) {
       const std::int64_t before = face_tri_eq_[f];
       rebuild_face(f);

@@ -65,6 +65,8 @@ FeatureReference make_feature_reference(const PolyMesh& mesh, const Connectivity
 /// triangle's unit normal: the reference of the orientation guarantee (docs/metrics.md §6b). A
 /// multi-pass reduction checks every pass against the original input, so an output face is
 /// never accepted facing away from the surface `eval` compares it with.
+struct VertexMirror;  // mesh/symmetry.h
+
 struct SurfaceReference {
   TriangleBvh bvh;
   std::vector<Vec3> normal;  ///< unit normal of each triangle of bvh (zero for zero area)
@@ -202,6 +204,16 @@ struct ClusterCollapseParams {
   /// Refused clusters are bisected (longest collapsed edges cut first) during this many rounds;
   /// from then on a refused cluster is dissolved entirely. 0: always dissolve.
   Index max_bisect_rounds = 8;
+
+  // --- symmetry (issue 34; docs/symmetry.md) ---------------------------------------------------
+  /// The mirror map of the mesh being collapsed (borrowed; nullptr: no symmetry). A cluster whose
+  /// mirror image is a cluster (every member's partner in one cluster of the same size) is placed
+  /// as the reflection of that cluster's placement, and a cluster that is its own mirror is placed
+  /// exactly on the plane; which side's placement is reflected: the one placed in the later round
+  /// (a re-placement wins), else the one placed on a feature line, else the smaller root. Refusals
+  /// are not mirrored here: simplify() intersects the collapsed edges with their mirrors and runs
+  /// the collapse again until they are symmetric.
+  const VertexMirror* mirror = nullptr;
 };
 
 /// Why a cluster was refused, in priority order (a cluster with several problems is counted

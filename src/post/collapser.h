@@ -76,6 +76,15 @@ class Collapser {
   void check_feature_edges(Index v);
   std::vector<std::pair<Index, std::uint8_t>> line_edges_;  // check_feature_edges: {w, kinds}
   void split(Index r, CollapseRefusal why, bool dissolve);
+  // --- symmetry (issue 34; docs/symmetry.md) ------------------------------------------------------
+  // Mirror placements: the roots placed in this round (placed_now_) get the reflection of their
+  // mirror cluster's position, or give theirs (see cluster_collapse.cpp); clusters overwritten
+  // that were not placed this round have their faces appended to `dirty` (with dirty_token_).
+  Index mirror_root(Index r) const;
+  bool holds_protected(Index root) const;  // a member has protect weight 1 (issue 34)
+  void mirror_placements(std::vector<Index>* dirty);
+  std::vector<Index> placed_now_;
+  std::vector<std::uint8_t> placed_on_feature_;
 
   // --- faces -----------------------------------------------------------------------------------
   Index piece_base(Index f) const { return 2 * mesh_.face_begin(f); }

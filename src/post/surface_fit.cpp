@@ -4,6 +4,7 @@
 #include "geometry/bvh.h"
 #include "mesh/connectivity.h"
 #include "mesh/features.h"
+#include "mesh/symmetry.h"
 #include "post/cluster_collapse.h"
 #include "util/parallel.h"
 
@@ -373,6 +374,44 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
       output.positions[v] = before[v] + d;
       moved[v] = 1;
     }
+    // Symmetry (issue 34): a pair moves by the mean of its two steps, mirrored; a vertex on the
+    // plane stays in it; a pair with a fixed member stays.
+    const std::vector<Index>* partner = params.mirror && params.mirror->partner.size() == nv ? &params.mirror->partner : nullptr;
+    if (partner) {
+      const MirrorPlane& plane = params.mirror->plane;
+      for (std::size_t v = 0; v < nv; ++v) {
+        const Index w = (*partner)[v];
+        if (w == kInvalidIndex || w < v) continue;
+        if (w == v) {
+          if (moved[v]) output.positions[v][plane.axis] = plane.centre;
+          continue;
+        }
+        if (!moved[v] && !moved[w]) continue;
+        if (fixed[v] || fixed[w]) {
+          output.positions[v] = before[v];
+          output.positions[w] = before[w];
+          moved[v] = moved[w] = 0;
+          continue;
+        }
+        output.positions[v] = 0.5 * (output.positions[v] + plane.reflect(output.positions[w]));
+        output.positions[w] = plane.reflect(output.positions[v]);
+        moved[v] = moved[w] = 1;
+      }
+    }
+    // Undoes v's move and its partner's (with symmetry).
+    auto undo = [&](Index v) {
+      if (moved[v]) {
+        output.positions[v] = before[v];
+        moved[v] = 0;
+        ++result.refused_moves;
+      }
+      if (!partner) return;
+      const Index w = (*partner)[v];
+      if (w == kInvalidIndex || w == v || !moved[w]) return;
+      output.positions[w] = before[w];
+      moved[w] = 0;
+      ++result.refused_moves;
+    };
     // The Hausdorff guard (above), for every moved vertex on all threads; each decides alone.
     parallel_chunks(nv, params.threads, 4096, [&](std::size_t begin, std::size_t end, std::size_t) {
       for (std::size_t v = begin; v < end; ++v) {
@@ -388,6 +427,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
         moved[v] = 0;
         ++result.refused_moves;
         ++result.refused_far;
+        if (partner) undo(Index(v));
       }
     // Undo the moves of every vertex of a face that turned or shrank too much, until none does
     // (undoing only returns vertices to where they were, so this ends).
@@ -402,9 +442,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
             continue;
           for (Index v : {le.v, le.w})
             if (moved[v]) {
-              output.positions[v] = before[v];
-              moved[v] = 0;
-              ++result.refused_moves;
+              undo(v);
               ++result.refused_line;
               changed = true;
             }
@@ -413,9 +451,7 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
         if (face_ok(static_cast<Index>(i))) continue;
         for (Index v : out_tris[i].v)
           if (moved[v]) {
-            output.positions[v] = before[v];
-            moved[v] = 0;
-            ++result.refused_moves;
+            undo(v);
             changed = true;
           }
       }
@@ -437,10 +473,9 @@ SurfaceFitResult fit_to_surface(const PolyMesh& input, PolyMesh& output, const S
         if (!needs_test(f) || (again ? faces_input(f, face_tol[f]) : faces_ok[f])) continue;
         for (Index v : fv)
           if (moved[v]) {
-            output.positions[v] = before[v];
-            moved[v] = 0;
+            undo(v);
             put_back[v] = 1;
-            ++result.refused_moves;
+            if (partner && (*partner)[v] != kInvalidIndex) put_back[(*partner)[v]] = 1;
             changed = true;
           }
       }

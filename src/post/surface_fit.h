@@ -32,6 +32,7 @@ struct SurfaceReference;  // post/cluster_collapse.h
 struct FeatureReference;  // post/cluster_collapse.h
 struct FeatureEdges;      // mesh/features.h
 struct Connectivity;      // mesh/connectivity.h
+struct VertexMirror;      // mesh/symmetry.h
 
 /// The strict lines the fit keeps its vertices on (SurfaceFitParams::lines).
 struct FitLines {
@@ -111,6 +112,14 @@ struct SurfaceFitParams {
   /// make_surface_reference(input, threads), borrowed (the run's: its BVH is ~5 % of a 1M-face
   /// run); nullptr: built here.
   const SurfaceReference* surface = nullptr;
+
+  // --- symmetry (issue 34; docs/symmetry.md) ---------------------------------------------------
+  /// The output's mirror pairs (borrowed; partner per output vertex, positions already exact
+  /// mirrors); nullptr: none. Each step then moves a pair by the mean of its own step and the
+  /// reflection of its partner's (a vertex on the plane only within it), a pair with a fixed
+  /// vertex stays, and any guard that undoes one vertex's move undoes its partner's too, so the
+  /// output stays exactly mirrored.
+  const VertexMirror* mirror = nullptr;
 };
 
 struct SurfaceFitResult {

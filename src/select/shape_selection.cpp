@@ -13,6 +13,7 @@
 // and its error; per face, its kept edges (Eq. 1 counts the face as max(0, kept − 2)).
 #include "select/shape_selection.h"
 
+#include "mesh/symmetry.h"
 #include "mesh/union_find.h"
 #include "select/groups.h"
 #include "util/parallel.h"
@@ -535,7 +536,10 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   sel.strategy = "shape-greedy";
   sel.stop_reason = "greedy";
   sel.target = target;
-  const std::vector<std::uint8_t> pinned = pinned_edges(conn, params);
+  std::vector<std::uint8_t> pinned = pinned_edges(conn, params);
+  // Symmetry (issue 34): an edge is pinned when its mirror is (non-manifold edges, a caller's
+  // list that was not symmetric), so the units and their mirrors are fixed alike.
+  if (params.edge_mirror && params.edge_mirror->size() == conn.num_edges) symmetrize_flags_union(pinned, *params.edge_mirror);
   const Units units = make_units(conn, analysis, params, pinned);
   ShapeState state(mesh, conn, params);
   sel.input_tri_equivalent = std::uint64_t(state.count());
@@ -564,10 +568,37 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
   };
   auto single_edge = [&](Index e) { return !pinned[e] && units.of(units.g.edge_group[e]).size() > 1; };
   Index single_scratch = 0;
+  // Symmetry (issue 34): a move's edges with their mirror images, each once; empty when a mirror
+  // edge is pinned (the move would collapse what must stay). `seen` marks the move's edges.
+  const std::vector<Index>* mirror = params.edge_mirror && params.edge_mirror->size() == conn.num_edges ? params.edge_mirror : nullptr;
+  struct MirrorScratch {
+    std::vector<Index> edges;
+    std::vector<std::uint32_t> seen;
+    std::uint32_t token = 0;
+  };
+  auto with_mirror = [&](std::span<const Index> edges, MirrorScratch& ms) -> std::span<const Index> {
+    if (ms.seen.size() != conn.num_edges) ms.seen.assign(conn.num_edges, 0);
+    ++ms.token;
+    ms.edges.assign(edges.begin(), edges.end());
+    for (Index e : edges) ms.seen[e] = ms.token;
+    for (Index e : edges) {
+      const Index m = (*mirror)[e];
+      if (m == kInvalidIndex || ms.seen[m] == ms.token) continue;
+      if (pinned[m]) return {};
+      ms.seen[m] = ms.token;
+      ms.edges.push_back(m);
+    }
+    return ms.edges;
+  };
+  MirrorScratch main_mirror;
   auto move_edges = [&](Index id) -> std::span<const Index> {
-    if (id < nu) return units.of(id);
-    single_scratch = id - nu;
-    return {&single_scratch, 1};
+    std::span<const Index> edges;
+    if (id < nu) edges = units.of(id);
+    else {
+      single_scratch = id - nu;
+      edges = {&single_scratch, 1};
+    }
+    return mirror ? with_mirror(edges, main_mirror) : edges;
   };
   auto priority = [&](Index id, const Move& m) {
     const double per = m.cost(params.lambda_shape) / double(m.reduced);
@@ -593,14 +624,20 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
     std::vector<std::pair<std::size_t, std::size_t>> filled;  // per chunk: begin, end of its writes
     std::mutex filled_mutex;
     std::atomic<std::int64_t> evaluations = 0;
-    auto price = [&](std::size_t begin, std::size_t end, Scratch* scratch) {
+    // One mirror scratch per worker (its `seen` has an entry per edge), made on first use.
+    std::vector<MirrorScratch> mirror_scratch(mirror ? std::max<std::size_t>(1, thread_count(params.threads)) : 0);
+    auto price = [&](std::size_t begin, std::size_t end, Scratch* scratch, std::size_t worker) {
       std::size_t out = begin;
       std::int64_t evaluated = 0;
       for (std::size_t i = begin; i < end; ++i) {
         const Index id = Index(i);
         if (id < nu ? bool(units.g.fixed[id]) : !single_edge(id - nu)) continue;
         Index one = id >= nu ? id - nu : 0;
-        const std::span<const Index> edges = id < nu ? units.of(id) : std::span<const Index>(&one, 1);
+        std::span<const Index> edges = id < nu ? units.of(id) : std::span<const Index>(&one, 1);
+        if (mirror) {
+          edges = with_mirror(edges, mirror_scratch[worker]);
+          if (edges.empty()) continue;
+        }
         const Move m = scratch ? state.evaluate(edges, *scratch) : state.evaluate(edges);
         ++evaluated;
         if (m.reduced > 0 && m.valid) first[out++] = {priority(id, m), id, version};
@@ -615,10 +652,10 @@ ShapeSelectionResult select_by_shape(const PolyMesh& mesh, const Connectivity& c
         n, params.threads, params.min_parallel_candidates, params.pricing_chunks_per_thread,
         [&](std::size_t i) { return i < std::size_t(nu) ? double(units.of(Index(i)).size()) : 1.0; },
         [&](std::size_t begin, std::size_t end, std::size_t worker) {
-          if (worker == 0) return price(begin, end, nullptr);  // the state's own scratch
+          if (worker == 0) return price(begin, end, nullptr, worker);  // the state's own scratch
           Scratch& own = scratch[worker - 1];
           if (own.root_token.empty()) own = state.make_scratch();
-          price(begin, end, &own);
+          price(begin, end, &own, worker);
         });
     std::sort(filled.begin(), filled.end());
     std::size_t size = 0;

@@ -92,6 +92,14 @@ struct ShapeSelectionParams {
   /// finish. 8: one chunk is then an eighth of a thread's share; measured on the 1M grid (speed
   /// only, the selection is the same for any value).
   std::size_t pricing_chunks_per_thread = 8;
+
+  // --- symmetry (issue 34; docs/symmetry.md) ---------------------------------------------------
+  /// Per Connectivity edge, its mirror edge (mesh/symmetry.h: mirror_edges; itself on the plane,
+  /// kInvalidIndex: none), borrowed; nullptr: no symmetry. Every move then collapses its edges and
+  /// their mirror images together — a segment with its mirror segment, a single edge with its
+  /// mirror edge — priced as one move, and a move whose mirror image holds a pinned edge is not
+  /// taken. keep_edges should be symmetric (simplify() makes it so).
+  const std::vector<Index>* edge_mirror = nullptr;
 };
 
 struct ShapeSelectionStats {

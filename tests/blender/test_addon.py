@@ -152,6 +152,47 @@ def main(zip_path):
         up = sum(1 for loop in lod.data.loops if loop.normal.z > 0.99)
         check(up == len(lod.data.loops), f"LOD normals are the custom ones ({up} of {len(lod.data.loops)} point up)")
 
+    # Symmetry (issue 34): Suzanne, her x < 0 half mirrored back (exact reflections), reduced with
+    # the toggle on gives a LOD whose every vertex has its mirror; the report names the plane.
+    bpy.ops.mesh.primitive_monkey_add(location=(0, 0, -5))
+    monkey = bpy.context.active_object
+    monkey.name = "Monkey"
+    import bmesh
+    bm = bmesh.new()
+    bm.from_mesh(monkey.data)
+    bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.x < -1e-5], context="VERTS")
+    for v in bm.verts:
+        if abs(v.co.x) <= 1e-5:
+            v.co.x = 0.0
+    bm.to_mesh(monkey.data)
+    bm.free()
+    bpy.ops.object.select_all(action="DESELECT")
+    monkey.select_set(True)
+    bpy.context.view_layer.objects.active = monkey
+    mirror = monkey.modifiers.new("Mirror", "MIRROR")
+    mirror.use_clip = True
+    bpy.ops.object.modifier_apply(modifier=mirror.name)
+
+    def unmirrored(mesh):
+        points = [tuple(v.co) for v in mesh.vertices]
+        tol = 1e-6 * max(1.0, max(abs(c) for p in points for c in p))
+        return sum(1 for p in points if min(abs(p[0] + q[0]) + abs(p[1] - q[1]) + abs(p[2] - q[2]) for q in points) > tol)
+
+    check(unmirrored(monkey.data) == 0, "test monkey is mirror-symmetric")
+    for toggle, axis in ((True, "AUTO"), (True, "X")):
+        for o in list(bpy.data.objects):
+            if o.name.startswith("Monkey_LOD"):
+                bpy.data.objects.remove(o)
+        monkey.select_set(True)
+        bpy.context.view_layer.objects.active = monkey
+        check(bpy.ops.object.quadlod_lod(levels=1, ratio=0.4, symmetry=toggle, symmetry_axis=axis) == {"FINISHED"},
+              f"operator with symmetry {axis}")
+        lod = bpy.data.objects.get("Monkey_LOD1")
+        check(lod is not None and unmirrored(lod.data) == 0,
+              f"symmetry {axis}: every LOD vertex has its mirror ({lod and unmirrored(lod.data)} without)")
+        check(lod is not None and lod["quadlod_report"]["symmetry"] == "x",
+              f"symmetry {axis}: the report names the x plane")
+
     # A mesh without faces: an error report and a cancelled operator, Blender goes on.
     empty_mesh = bpy.data.meshes.new("Empty")
     empty_mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])

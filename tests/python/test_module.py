@@ -244,6 +244,31 @@ def test_seams_policy_reaches_the_reduction():
         quadlod.simplify(vertices, faces, ratio=0.4, seams="loose")
 
 
+def test_symmetry_keeps_a_mirrored_mesh_mirrored():
+    """symmetry (the CLI's --symmetry, issue 34): a grid bent symmetrically about x = 0 reduces to
+    a mesh whose every vertex has its mirror image; jittered, it gets the note and off's output."""
+    n, m = 16, 12
+    xs, ys = np.meshgrid(np.linspace(-1.0, 1.0, n + 1), np.linspace(-0.75, 0.75, m + 1))
+    zs = 0.3 * np.exp(-3.0 * (xs ** 2 + ys ** 2)) + 0.15 * ys + 0.05 * xs ** 2
+    vertices = np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)
+    faces = np.array([[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i]
+                      for j in range(m) for i in range(n)])
+    for symmetry in ("auto", "x"):
+        r = quadlod.simplify(vertices, faces, ratio=0.4, symmetry=symmetry)
+        assert r["report"]["symmetry"]["axis"] == "x"
+        v = r["vertices"]
+        mirrored = v * np.array([-1.0, 1.0, 1.0])
+        gaps = np.min(np.linalg.norm(v[:, None, :] - mirrored[None, :, :], axis=2), axis=1)
+        assert np.max(gaps) <= 1e-9 * 2.5
+    jittered = vertices + np.random.default_rng(34).uniform(-0.02, 0.02, vertices.shape) * np.array([0, 0, 1])
+    off = quadlod.simplify(jittered, faces, ratio=0.4, symmetry="off")
+    auto = quadlod.simplify(jittered, faces, ratio=0.4, symmetry="auto")
+    assert "not mirror-symmetric" in auto["report"]["symmetry"]["note"]
+    assert np.array_equal(auto["vertices"], off["vertices"]) and np.array_equal(auto["faces"], off["faces"])
+    with pytest.raises(ValueError, match="symmetry: 'auto', 'x', 'y', 'z' or 'off', not 'w'"):
+        quadlod.simplify(vertices, faces, ratio=0.4, symmetry="w")
+
+
 def test_the_input_arrays_are_not_modified():
     vertices, quads, uvs, materials = torus()
     copies = [a.copy() for a in (vertices, quads, uvs, materials)]

@@ -32,6 +32,10 @@ EFFORT_ITEMS = [
 ]
 
 
+# The core's default (SimplifyOptions::symmetry): on, auto-detected — see docs/symmetry.md.
+SYMMETRY_DEFAULT = True
+
+
 def _settings_annotations():
     """The knobs shared by the operator and the panel's scene settings (a fresh dict per class)."""
     return dict(
@@ -60,6 +64,20 @@ def _settings_annotations():
             name="Protect", default="",
             description="Vertex group whose weights protect vertices: 1 = kept exactly (with the edges between "
                         "such vertices), between 0 and 1 = reduced later; empty = none"),
+        # --- symmetry (issue 34; docs/symmetry.md) ---
+        symmetry=BoolProperty(
+            name="Symmetry",
+            description="Keep a mirror-symmetric mesh symmetric: mirrored collapses and placements about a "
+                        "plane through the centre of the mesh's bounding box (local axes). A mesh that is not "
+                        "symmetric is reduced without it (the LOD's report says so)",
+            default=SYMMETRY_DEFAULT),
+        symmetry_axis=EnumProperty(
+            name="Axis",
+            items=[("AUTO", "Auto", "The axis plane the mesh is mirror-symmetric about"),
+                   ("X", "X", "Mirror across the local X axis"),
+                   ("Y", "Y", "Mirror across the local Y axis"),
+                   ("Z", "Z", "Mirror across the local Z axis")],
+            default="AUTO"),
     )
 
 
@@ -229,6 +247,7 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
 
     def _options(self):
         options = dict(features=self.protect_uv_seams)
+        options.update(symmetry=self.symmetry_axis.lower() if self.symmetry else "off")  # issue 34
         if self.effort == "FAST":
             options.update(effort=0.5)
         elif self.effort == "THOROUGH":
@@ -279,6 +298,11 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
                                  ("input_tri_equivalent", "target", "achieved", "quads", "triangles", "ngons")}
         if "protect" in level["report"]:
             lod["quadlod_report"]["protected_vertices"] = level["report"]["protect"]["protected_vertices"]
+        # issue 34: the plane this level was reduced about ("none"), and why not when it was asked for
+        symmetry = level["report"].get("symmetry", {})
+        lod["quadlod_report"]["symmetry"] = symmetry.get("axis", "none")
+        if symmetry.get("note"):
+            lod["quadlod_report"]["symmetry_note"] = symmetry["note"]
         self._made.append(lod)
         self._done += 1
 
@@ -372,6 +396,11 @@ class QUADLOD_PT_panel(bpy.types.Panel):
             layout.prop_search(settings, "protect_group", active, "vertex_groups", text="Protect")
         else:
             layout.prop(settings, "protect_group", text="Protect")
+        row = layout.row(align=True)  # issue 34: as Decimate's Symmetry toggle and axis
+        row.prop(settings, "symmetry")
+        sub = row.row(align=True)
+        sub.enabled = settings.symmetry
+        sub.prop(settings, "symmetry_axis", text="")
         layout.prop(settings, "effort")
         row = layout.row()
         row.enabled = settings.effort == "ILP"
