@@ -22,6 +22,7 @@ struct BatchCliOptions {
   std::string recover_quads;
   std::string seams;
   int threads = -1;
+  double morph_weight = -1.0;  // issue 34: blend shapes (< 0 = the default)
 };
 
 }  // namespace
@@ -50,6 +51,8 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"auto", "strict"}));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges");
+  sub->add_option("--morph-weight", opt->morph_weight, "Blend shapes: weight of each shape's geometry in the error, against the base's 1 (0 = the base alone; docs/blend_shapes.md)")
+      ->check(CLI::Range(0.0, 100.0));
   sub->add_option("--shard", opt->shard,
                   "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
                   "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT or $JOB_COMPLETION_INDEX/N")
@@ -72,6 +75,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (!opt->seams.empty()) defaults["seams"] = opt->seams;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
+            if (opt->morph_weight >= 0.0) defaults["morph_weight"] = opt->morph_weight;  // issue 34
             const bool folder = std::filesystem::is_directory(opt->source);
             if (folder && opt->output_dir.empty()) {
               std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");

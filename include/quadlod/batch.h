@@ -20,7 +20,8 @@ namespace quadlod {
 ///   "format": "glb" | "fbx" | …      → lod: file format (default: the input's, else glb);
 ///   "per_mesh": bool, "objective": "shape" | "paper", "time_limit": s, "threads": n,
 ///   "seed": n, "features": bool,
-///   "recover_quads": "auto" | "on" | "off" → as the CLI's options of the same names.
+///   "recover_quads": "auto" | "on" | "off",
+///   "morph_weight": w (issue 34: blend shapes) → as the CLI's options of the same names.
 /// Unknown keys are an error of that job (a typo must not silently change the run).
 struct BatchJob {
   std::filesystem::path input;

@@ -175,6 +175,7 @@ class SceneBuilder {
     Index id = kInvalidIndex;
     if (out.mesh.num_faces() > 0) {
       for (unsigned m : group) per_mesh_extras(*ai_.mMeshes[m], out);
+      read_morph_targets(group, out.mesh);
       id = static_cast<Index>(scene_.meshes.size());
       scene_.meshes.push_back(std::move(out));
     }
@@ -469,6 +470,51 @@ class SceneBuilder {
       }
     }
     mesh.skin = make_skin_weights(lists);
+  }
+
+  /// Issue 34: the blend shapes of a group's aiMeshes (aiMesh::mAnimMeshes, absolute positions
+  /// per aiMesh vertex) as per-vertex displacements of the welded mesh. Target k of every aiMesh
+  /// of the group is one MorphTarget (glTF: every primitive of a mesh has the same targets; FBX:
+  /// one channel per shape), named by the first aiMesh that names it. A welded vertex takes its
+  /// displacement from the first aiMesh vertex that maps onto it (the corners of one vertex split
+  /// at a UV seam carry the same shape). The default weight is glTF's `mesh.weights`; assimp's
+  /// FBX reader gives the channel's full weight (1), not Blender's current value, so FBX shapes
+  /// read with default weight 0. Anim meshes without positions (normals only) give no target.
+  void read_morph_targets(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    unsigned targets = 0;
+    for (unsigned m : group) targets = std::max(targets, ai_.mMeshes[m]->mNumAnimMeshes);
+    if (targets == 0) return;
+    const bool gltf = source_is_gltf();
+    std::vector<MorphTarget> out(targets);
+    std::vector<char> has_positions(targets, 0);
+    for (MorphTarget& t : out) t.displacement.assign(mesh.num_vertices(), Vec3::Zero());
+    std::vector<std::vector<char>> set(targets, std::vector<char>(mesh.num_vertices(), 0));
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      const auto recorded = welded_of_.find(&a);
+      if (recorded == welded_of_.end()) continue;  // no face of `a` survived the weld
+      const std::vector<Index>& welded_of = recorded->second;
+      for (unsigned k = 0; k < a.mNumAnimMeshes; ++k) {
+        const aiAnimMesh* am = a.mAnimMeshes[k];
+        if (!am || !am->mVertices || am->mNumVertices != a.mNumVertices) continue;
+        has_positions[k] = 1;
+        if (out[k].name.empty() && am->mName.length > 0) {
+          out[k].name = am->mName.C_Str();
+          if (gltf) out[k].default_weight = am->mWeight;
+        } else if (gltf && out[k].default_weight == 0.0) {
+          out[k].default_weight = am->mWeight;
+        }
+        for (unsigned v = 0; v < a.mNumVertices; ++v) {
+          const Index w = welded_of[v];
+          if (w == kInvalidIndex || set[k][w]) continue;
+          set[k][w] = 1;
+          const aiVector3D d = am->mVertices[v] - a.mVertices[v];
+          out[k].displacement[w] = Vec3(d.x, d.y, d.z);
+        }
+      }
+    }
+    for (unsigned k = 0; k < targets; ++k)
+      if (has_positions[k]) mesh.morph_targets.push_back(std::move(out[k]));
   }
 
   /// The joint of a bone name, created on first use with the bone's offset matrix as B⁻¹.

@@ -35,7 +35,8 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
-                                               "recover_quads", "seams"};
+                                               "recover_quads", "seams",
+                                               "morph_weight"};  // issue 34: blend shapes
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -61,6 +62,10 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
       const auto policy = parse_seam_policy(options["seams"].get<std::string>());
       if (!policy) return "seams must be auto or strict";
       simplify.seams = *policy;
+    }
+    if (options.contains("morph_weight")) {  // issue 34: blend shapes
+      simplify.morph_error_weight = options["morph_weight"].get<double>();
+      if (!(simplify.morph_error_weight >= 0.0)) return "morph_weight must be >= 0";
     }
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());
