@@ -19,7 +19,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def blender(script, *args):
-    run = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+    run = subprocess.run(["blender", "-b", "--python-exit-code", "1", "--python",
                           os.path.join(HERE, "blend_shapes", script), "--", *args],
                          capture_output=True, text=True)
     if run.returncode != 0:

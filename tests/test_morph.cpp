@@ -12,6 +12,7 @@
 #include "quadlod/morph.h"
 #include "quadlod/scene.h"
 #include "quadlod/simplify.h"
+#include "quadlod/skin_io.h"
 
 #include <gtest/gtest.h>
 
@@ -335,6 +336,29 @@ TEST_F(MorphIo, FbxRoundTripKeepsTheTargets) {
   ASSERT_TRUE(r.ok()) << r.error;
   ASSERT_EQ(r.scene.meshes.size(), 1u);
   expect_same_targets(mesh, r.scene.meshes[0].mesh, /*weights=*/false);
+}
+
+// Skinned meshes take quadlod's own glTF reader and writer (issue 24): the targets go through
+// them too, and through the CLI's skinned path.
+TEST_F(MorphIo, SkinnedGlbKeepsTheTargetsThroughTheSkinnedPath) {
+  SkinnedMesh tube = make_bending_tube(12, 16, 2);
+  MorphTarget bulge_x{"bulge", 0.3, {}};
+  for (const Vec3& p : tube.mesh.positions) bulge_x.displacement.push_back(Vec3(0.1 * p.x() * std::max(0.0, p.z()), 0, 0));
+  tube.mesh.morph_targets.push_back(bulge_x);
+  const fs::path glb = dir / "tube.glb", out = dir / "lod.glb";
+  ASSERT_TRUE(write_skinned_glb(tube.mesh, tube.rig, glb).ok());
+  const SkinnedReadResult r = read_skinned_gltf(glb);
+  ASSERT_TRUE(r.ok()) << r.error;
+  expect_same_targets(tube.mesh, r.skinned.mesh, /*weights=*/true);
+  const testing::CliRun run = testing::run_cli("simplify '" + glb.string() + "' -o '" + out.string() + "' --ratio 0.5", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  const SkinnedReadResult lod = read_skinned_gltf(out);
+  ASSERT_TRUE(lod.ok()) << lod.error;
+  ASSERT_EQ(lod.skinned.mesh.morph_targets.size(), 1u);
+  EXPECT_EQ(lod.skinned.mesh.morph_targets[0].name, "bulge");
+  EXPECT_NEAR(lod.skinned.mesh.morph_targets[0].default_weight, 0.3, 1e-6);
+  EXPECT_FALSE(lod.skinned.mesh.skin.empty());
+  EXPECT_LT(lod.skinned.mesh.num_vertices(), tube.mesh.num_vertices());
 }
 
 // The issue's command on a .glb with a shape: the output .glb has the shape, reduced.
