@@ -325,8 +325,8 @@ TEST_F(MorphIo, GltfRoundTripKeepsTheTargets) {
   expect_same_targets(r.scene.meshes[0].mesh, r2.scene.meshes[0].mesh, /*weights=*/true);
 }
 
-// FBX blend shapes through assimp's exporter and reader: names and displacements (FBX's default
-// weight is not read, docs/blend_shapes.md).
+// FBX blend shapes through assimp's exporter and reader (both with quadlod's repairs): names,
+// displacements and default weights (DeformPercent).
 TEST_F(MorphIo, FbxRoundTripKeepsTheTargets) {
   const PolyMesh mesh = grid_with_targets();
   const fs::path fbx = dir / "grid.fbx";
@@ -335,7 +335,8 @@ TEST_F(MorphIo, FbxRoundTripKeepsTheTargets) {
   const SceneReadResult r = read_scene(fbx);
   ASSERT_TRUE(r.ok()) << r.error;
   ASSERT_EQ(r.scene.meshes.size(), 1u);
-  expect_same_targets(mesh, r.scene.meshes[0].mesh, /*weights=*/false);
+  // The default weights come back from the channels' DeformPercent.
+  expect_same_targets(mesh, r.scene.meshes[0].mesh, /*weights=*/true);
 }
 
 // Skinned meshes take quadlod's own glTF reader and writer (issue 24): the targets go through

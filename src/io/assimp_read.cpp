@@ -477,9 +477,9 @@ class SceneBuilder {
   /// of the group is one MorphTarget (glTF: every primitive of a mesh has the same targets; FBX:
   /// one channel per shape), named by the first aiMesh that names it. A welded vertex takes its
   /// displacement from the first aiMesh vertex that maps onto it (the corners of one vertex split
-  /// at a UV seam carry the same shape). The default weight is glTF's `mesh.weights`; assimp's
-  /// FBX reader gives the channel's full weight (1), not Blender's current value, so FBX shapes
-  /// read with default weight 0. Anim meshes without positions (normals only) give no target.
+  /// at a UV seam carry the same shape). The default weight is glTF's `mesh.weights`; for a
+  /// binary FBX the channel's DeformPercent / 100 (fbx_deform_percent: assimp's reader gives the
+  /// channel's full weight instead, 1), else 0. Anim meshes without positions give no target.
   void read_morph_targets(const std::vector<unsigned>& group, PolyMesh& mesh) {
     unsigned targets = 0;
     for (unsigned m : group) targets = std::max(targets, ai_.mMeshes[m]->mNumAnimMeshes);
@@ -501,6 +501,8 @@ class SceneBuilder {
         if (out[k].name.empty() && am->mName.length > 0) {
           out[k].name = am->mName.C_Str();
           if (gltf) out[k].default_weight = am->mWeight;
+          if (const auto it = fbx_deform_percent.find(out[k].name); it != fbx_deform_percent.end())
+            out[k].default_weight = it->second / 100.0;
         } else if (gltf && out[k].default_weight == 0.0) {
           out[k].default_weight = am->mWeight;
         }
@@ -625,6 +627,11 @@ class SceneBuilder {
   const aiScene& ai_;
   const double normal_weld_cos_;
   const fbx::GeometryRead* fbx_;
+ public:
+  /// Issue 34: a binary FBX's blend shape channels' DeformPercent by channel name (assimp 5.2
+  /// hands over FullWeights, not the channel's current value, which Blender writes there).
+  std::map<std::string, double> fbx_deform_percent;
+ private:
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
   std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
@@ -644,6 +651,8 @@ void configure(Assimp::Importer& importer) {
 /// `bytes`: the file's bytes when it may be a binary FBX (else empty): its control points give
 /// the meshes their vertices (fbx_control_points.h). A binary FBX that assimp reads but our
 /// parser refuses, or one written by assimp, is glued as before, with Scene::fbx_note saying why.
+std::map<std::string, double> read_fbx_deform_percent(const aiScene& ai, std::string_view bytes);
+
 SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
                        const SceneReadOptions& options, std::string_view bytes) {
   SceneReadResult result;
@@ -664,9 +673,33 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
       note = "FBX written by assimp (per-corner control points); corners glued along edges";
   }
   const bool use = binary_fbx && note.empty();
-  result.scene = SceneBuilder(*ai, options, use ? &geometries : nullptr).build();
+  SceneBuilder builder(*ai, options, use ? &geometries : nullptr);
+  if (fbx::is_binary_fbx(bytes)) builder.fbx_deform_percent = read_fbx_deform_percent(*ai, bytes);
+  result.scene = builder.build();
   if (!note.empty()) result.scene.fbx_note = note;
   return result;
+}
+
+/// Issue 34: DeformPercent of every BlendShapeChannel of a binary FBX, by channel name (the
+/// name before the "\0\1" class separator); empty when no aiMesh has blend shapes (the file is
+/// not parsed again) or the record tree does not parse.
+std::map<std::string, double> read_fbx_deform_percent(const aiScene& ai, std::string_view bytes) {
+  std::map<std::string, double> out;
+  bool shapes = false;
+  for (unsigned m = 0; m < ai.mNumMeshes; ++m) shapes = shapes || ai.mMeshes[m]->mNumAnimMeshes > 0;
+  if (!shapes) return out;
+  const fbx::ParseResult parsed = fbx::parse_binary_fbx(bytes);
+  const fbx::Record* objects = parsed.ok() ? parsed.document.find("Objects") : nullptr;
+  if (!objects) return out;
+  for (const fbx::Record& r : objects->children) {
+    if (r.name != "Deformer" || r.string_property(2) != "BlendShapeChannel") continue;
+    const fbx::Record* percent = r.find("DeformPercent");
+    if (!percent || percent->properties.empty() || percent->properties[0].reals.empty()) continue;
+    std::string name = r.string_property(1);
+    name = name.substr(0, name.find(std::string_view("\0\1", 2)));
+    out.try_emplace(name, percent->properties[0].reals[0]);
+  }
+  return out;
 }
 
 /// The file's bytes when it starts with the binary FBX magic, else "".
