@@ -377,6 +377,36 @@ TEST_F(MorphIo, CliSimplifyCarriesTheTargetsIntoTheGlb) {
   EXPECT_EQ(lod.morph_targets[1].name, "bulge");
   EXPECT_NEAR(lod.morph_targets[1].default_weight, 0.75, 1e-6);
   EXPECT_LT(lod.num_vertices(), (kGrid + 1) * (kGrid + 1));
+  // --morph-weight reaches the reduction (the mesh's report); OBJ holds no shapes and says so.
+  const fs::path obj = dir / "out.obj", report = dir / "report.json";
+  const testing::CliRun to_obj = testing::run_cli(
+      "simplify '" + in.string() + "' -o '" + obj.string() + "' --ratio 0.4 --morph-weight 2.5 --report '" + report.string() + "'", dir);
+  ASSERT_EQ(to_obj.exit_code, 0) << to_obj.err << to_obj.out;
+  EXPECT_NE(to_obj.err.find("2 blend shape(s) dropped: OBJ, PLY and OFF hold none"), std::string::npos) << to_obj.err;
+  const std::string text = testing::slurp(report);
+  EXPECT_NE(text.find("\"morph_error_weight\": 2.5"), std::string::npos) << text;
+  const testing::CliRun bad = testing::run_cli("simplify '" + in.string() + "' -o '" + obj.string() + "' --ratio 0.4 --morph-weight -1", dir);
+  EXPECT_NE(bad.exit_code, 0);
+}
+
+// Batch manifests take "morph_weight" (and refuse a negative one); the shapes reach the outputs.
+TEST_F(MorphIo, BatchManifestCarriesTheTargetsAndTakesMorphWeight) {
+  fs::create_directories(dir / "assets");
+  ASSERT_TRUE(write_scene(scene_from_mesh(grid_with_targets(), "grid"), dir / "assets" / "grid.glb").ok());
+  testing::write_text(dir / "jobs.jsonl",
+                      "{\"input\": \"assets/grid.glb\", \"output\": \"out/a.glb\", \"ratio\": 0.4, \"morph_weight\": 2}\n"
+                      "{\"input\": \"assets/grid.glb\", \"output\": \"out/lods\", \"levels\": [0.5, 0.25]}\n"
+                      "{\"input\": \"assets/grid.glb\", \"output\": \"out/b.glb\", \"ratio\": 0.4, \"morph_weight\": -1}\n");
+  const testing::CliRun run = testing::run_cli("-q batch '" + (dir / "jobs.jsonl").string() + "'", dir);
+  EXPECT_NE(run.exit_code, 0);  // the negative weight
+  EXPECT_NE(run.out.find("morph_weight must be >= 0"), std::string::npos) << run.out;
+  for (const fs::path& p : {dir / "out" / "a.glb", dir / "out" / "lods" / "grid.lod1.glb", dir / "out" / "lods" / "grid.lod2.glb"}) {
+    const SceneReadResult r = read_scene(p);
+    ASSERT_TRUE(r.ok()) << r.error;
+    ASSERT_EQ(r.scene.meshes.size(), 1u);
+    ASSERT_EQ(r.scene.meshes[0].mesh.morph_targets.size(), 2u) << p;
+    EXPECT_EQ(r.scene.meshes[0].mesh.morph_targets[1].name, "bulge");
+  }
 }
 
 // Blender (Debian's 3.4) re-imports quadlod's .glb and .fbx with the shape keys: names, and
