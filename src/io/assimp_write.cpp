@@ -329,6 +329,12 @@ void write_fbx_record(const FbxRecord& record, std::string& out) {
 // normals are the base's: quadlod carries positions only), and each channel DeformPercent = the
 // shape's default weight × 100 (by its name).
 
+std::uint32_t read_u32(std::string_view d, std::size_t pos) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(d[pos + i]);
+  return v;
+}
+
 /// The properties of a head: (type, offset of the value) in order; empty when malformed.
 struct FbxHead {
   std::string name;
@@ -345,9 +351,7 @@ FbxHead parse_head(std::string_view head) {
   for (std::uint64_t i = 0; i < count && pos < head.size(); ++i) {
     const char type = head[pos];
     out.properties.emplace_back(type, pos + 1);
-    const auto u32 = [&](std::size_t at) {
-      return at + 4 <= head.size() ? std::uint32_t(read_u64(std::string(head.substr(at, 4)) + std::string(4, '\0'), 0)) : 0u;
-    };
+    const auto u32 = [&](std::size_t at) { return at + 4 <= head.size() ? read_u32(head, at) : 0u; };
     switch (type) {
       case 'Y': pos += 3; break;
       case 'C': pos += 2; break;
@@ -363,7 +367,8 @@ FbxHead parse_head(std::string_view head) {
 }
 
 std::string head_string(std::string_view head, std::size_t at) {  // an 'S' property's value
-  const std::uint32_t n = std::uint32_t(read_u64(std::string(head.substr(at, 4)) + std::string(4, '\0'), 0));
+  const std::uint32_t n = at + 4 <= head.size() ? read_u32(head, at) : 0u;
+  if (at + 4 + n > head.size()) return {};
   return std::string(head.substr(at + 4, n));
 }
 
@@ -387,6 +392,8 @@ std::string string_property(const std::string& s) {
 }
 
 void fix_fbx_blend_shapes(std::vector<FbxRecord>& top, const Scene& scene) {
+  // The channels are named after the shapes (add_anim_meshes); two meshes with a shape of one
+  // name share the first one's weight.
   std::map<std::string, double> weight_of;
   for (const SceneMesh& m : scene.meshes)
     for (const MorphTarget& t : m.mesh.morph_targets)
@@ -395,7 +402,9 @@ void fix_fbx_blend_shapes(std::vector<FbxRecord>& top, const Scene& scene) {
     if (parse_head(objects.head).name != "Objects") continue;
     for (FbxRecord& object : objects.children) {
       const FbxHead h = parse_head(object.head);
-      if (h.properties.size() != 3 || h.properties[1].first != 'S' || h.properties[2].first != 'S') continue;
+      if (h.properties.size() != 3 || h.properties[0].first != 'L' || h.properties[1].first != 'S' ||
+          h.properties[2].first != 'S')
+        continue;
       const std::string name = head_string(object.head, h.properties[1].second);
       const std::string kind = head_string(object.head, h.properties[2].second);
       const std::string plain = name.substr(0, name.find(std::string("\0\1", 2)));
@@ -405,11 +414,11 @@ void fix_fbx_blend_shapes(std::vector<FbxRecord>& top, const Scene& scene) {
         std::string properties(object.head.substr(id_at, 9));
         properties += string_property(plain + std::string("\0\1", 2) + "Geometry") + string_property("Shape");
         object.own_head = make_head("Geometry", 3, properties);
-        std::uint32_t points = 0;
+        std::uint32_t values = 0;  // of the Vertices array (3 per moved point); Normals as many
         for (const FbxRecord& child : object.children) {
           const FbxHead c = parse_head(child.head);
           if (c.name == "Vertices" && c.properties.size() == 1 && c.properties[0].first == 'd')
-            points = std::uint32_t(read_u64(std::string(child.head.substr(c.properties[0].second, 4)) + std::string(4, '\0'), 0));
+            values = read_u32(child.head, c.properties[0].second);
         }
         FbxRecord version;
         std::string v(1, 'I');
@@ -417,10 +426,10 @@ void fix_fbx_blend_shapes(std::vector<FbxRecord>& top, const Scene& scene) {
         version.own_head = make_head("Version", 1, v);
         FbxRecord normals;
         std::string n(1, 'd');
-        append_u32(n, points);  // count
+        append_u32(n, values);  // count
         append_u32(n, 0);       // raw
-        append_u32(n, points * 8);
-        n.append(std::size_t(points) * 8, '\0');
+        append_u32(n, values * 8);
+        n.append(std::size_t(values) * 8, '\0');
         normals.own_head = make_head("Normals", 1, n);
         object.children.insert(object.children.begin(), std::move(version));
         object.children.push_back(std::move(normals));
