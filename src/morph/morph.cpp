@@ -1,7 +1,7 @@
 // Blend shapes: posing and the carry by projection (include/quadlod/morph.h).
 #include "quadlod/morph.h"
 
-#include "skin/surface_projection.h"
+#include "morph/morph_transfer.h"
 
 namespace quadlod {
 
@@ -26,9 +26,13 @@ PolyMesh apply_morph_target(const PolyMesh& mesh, Index k) {
 
 std::vector<MorphTarget> transfer_morph_targets(const PolyMesh& source, const PolyMesh& target,
                                                 const SkinTransferParams& params) {
+  if (source.morph_targets.empty()) return {};
+  return blend_morph_targets(source, target, project_onto_surface(source, target, params));
+}
+
+std::vector<MorphTarget> blend_morph_targets(const PolyMesh& source, const PolyMesh& target, SurfaceProjection projection) {
   std::vector<MorphTarget> out;
   if (source.morph_targets.empty()) return out;
-  SurfaceProjection projection = project_onto_surface(source, target, params);
   // A vertex on one of its triangle's corners (it did not move: the closest point is that corner
   // up to the rounding of the closest-point arithmetic) takes that corner alone, so it keeps its
   // input displacement bit for bit.

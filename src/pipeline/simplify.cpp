@@ -15,7 +15,7 @@
 #include "skin/skin_borders.h"
 #include "skin/pose_quadrics.h"
 #include "morph/morph_quadrics.h"
-#include "quadlod/morph.h"
+#include "morph/morph_transfer.h"
 #include "quadlod/skin.h"
 #include "topology/analysis.h"
 #include "util/parallel.h"
@@ -731,6 +731,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   if (reference) cp.feature_reference = &*reference;
   PolyMesh current;
   const PolyMesh* pass_input = &input;
+  // Blend shapes (issue 34): every pass's output is projected onto the original input, whose
+  // search structures are built once (morph/morph_transfer.h).
+  std::optional<SurfaceProjector> shape_source;
+  if (!input.morph_targets.empty()) shape_source.emplace(input);
+  auto carry_shapes = [&](PolyMesh& mesh) {
+    if (shape_source) mesh.morph_targets = blend_morph_targets(input, mesh, shape_source->project(mesh));
+  };
   // Output face → original input face, composed over the passes (exact island accounting).
   std::vector<Index> face_origin(input.num_faces());
   std::iota(face_origin.begin(), face_origin.end(), Index{0});
@@ -826,7 +833,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     // next pass sees its joint-influence borders and the output carries weights.
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
     // Blend shapes (issue 34) by the same projection: the next pass prices them on its input.
-    current.morph_targets = transfer_morph_targets(input, current);
+    carry_shapes(current);
     pass_input = &current;
     if (pass >= planned &&
         std::abs(double(last.achieved) - n) <= options.round_tolerance * n)
@@ -902,7 +909,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"refused_far", fit.refused_far},
                              {"refused_line", fit.refused_line}};
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
-    current.morph_targets = transfer_morph_targets(input, current);
+    carry_shapes(current);
     report["stage_seconds"]["fit"] = fit_clock.seconds();
   }
   // Summary.

@@ -9,6 +9,7 @@
 #include "quadlod/skin.h"
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace quadlod {
@@ -25,5 +26,23 @@ struct SurfaceProjection {
 
 /// See the file comment; params.max_influences and min_weight are not used. Deterministic.
 SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& target, const SkinTransferParams& params = {});
+
+/// The same, with the source's search structures (triangles, BVHs, parts) built once and used
+/// for every target: a reduction projects each pass's output onto its original input.
+/// project(target) == project_onto_surface(source, target, params). `source` must outlive it
+/// only while it is constructed (it keeps copies of what it needs).
+class SurfaceProjector {
+ public:
+  explicit SurfaceProjector(const PolyMesh& source, const SkinTransferParams& params = {});
+  ~SurfaceProjector();
+  SurfaceProjector(const SurfaceProjector&) = delete;
+  SurfaceProjector& operator=(const SurfaceProjector&) = delete;
+  SurfaceProjection project(const PolyMesh& target) const;
+
+ private:
+  struct Surface;  // weight_transfer.cpp's SourceSurface
+  std::unique_ptr<Surface> surface_;
+  SkinTransferParams params_;
+};
 
 }  // namespace quadlod

@@ -202,9 +202,12 @@ std::vector<Index> match_parts(const SourceSurface& source, const PolyMesh& targ
 
 }  // namespace
 
-SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& target, const SkinTransferParams& params) {
+namespace {
+
+// One projection of `target` onto a built source surface (the part BVHs built when parts are
+// kept and the source has several).
+SurfaceProjection project_with(const SourceSurface& surface, const PolyMesh& target, const SkinTransferParams& params) {
   SurfaceProjection result;
-  SourceSurface surface(source, params);
 
   // Area-weighted vertex normals of the target.
   std::vector<Vec3> vertex_normal(target.num_vertices(), Vec3::Zero());
@@ -218,7 +221,6 @@ SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& t
   result.parts = target_parts;
   std::vector<Index> matched(target_parts, kInvalidIndex);
   if (params.keep_parts && surface.parts > 1 && !surface.triangles.empty()) {
-    surface.build_part_bvhs();
     matched = match_parts(surface, target, target_part, target_parts, vertex_normal, params);
     for (Index m : matched) result.parts_matched += m != kInvalidIndex;
   }
@@ -245,6 +247,31 @@ SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& t
   result.mean_distance = target.num_vertices() ? sum_distance / target.num_vertices() : 0.0;
   return result;
 }
+
+bool keeps_parts(const SourceSurface& surface, const SkinTransferParams& params) {
+  return params.keep_parts && surface.parts > 1 && !surface.triangles.empty();
+}
+
+}  // namespace
+
+SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& target, const SkinTransferParams& params) {
+  SourceSurface surface(source, params);
+  if (keeps_parts(surface, params)) surface.build_part_bvhs();
+  return project_with(surface, target, params);
+}
+
+struct SurfaceProjector::Surface : SourceSurface {
+  using SourceSurface::SourceSurface;
+};
+
+SurfaceProjector::SurfaceProjector(const PolyMesh& source, const SkinTransferParams& params)
+    : surface_(std::make_unique<Surface>(source, params)), params_(params) {
+  if (keeps_parts(*surface_, params_)) surface_->build_part_bvhs();
+}
+
+SurfaceProjector::~SurfaceProjector() = default;
+
+SurfaceProjection SurfaceProjector::project(const PolyMesh& target) const { return project_with(*surface_, target, params_); }
 
 SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
                                          const SkinTransferParams& params) {
