@@ -18,6 +18,8 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -323,6 +325,32 @@ TEST_F(MorphIo, GltfRoundTripKeepsTheTargets) {
   const SceneReadResult r2 = read_scene(again);
   ASSERT_TRUE(r2.ok()) << r2.error;
   expect_same_targets(r.scene.meshes[0].mesh, r2.scene.meshes[0].mesh, /*weights=*/true);
+}
+
+// A blend shape value that is not a number is bad input: one line naming the file, the mesh,
+// the shape and the vertex (not a mesh that fails check_layout later).
+TEST_F(MorphIo, ANonFiniteShapeValueIsAReadError) {
+  PolyMesh mesh = make_grid(4, 4);
+  MorphTarget t{"odd", 0.0, std::vector<Vec3>(mesh.num_vertices(), Vec3::Zero())};
+  t.displacement[7] = Vec3(0, 0, 0.123456);
+  mesh.morph_targets.push_back(t);
+  const fs::path glb = dir / "odd.glb";
+  ASSERT_TRUE(write_scene(scene_from_mesh(mesh, "grid"), glb).ok());
+  std::string bytes = testing::slurp(glb);
+  const float value = 0.123456f, nan = std::numeric_limits<float>::quiet_NaN();
+  std::string pattern(4, '\0'), replacement(4, '\0');
+  std::memcpy(pattern.data(), &value, 4);
+  std::memcpy(replacement.data(), &nan, 4);
+  const std::size_t at = bytes.find(pattern);
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(bytes.find(pattern, at + 1), std::string::npos);  // the one value of the shape
+  bytes.replace(at, 4, replacement);
+  testing::write_text(glb, bytes);
+  const SceneReadResult r = read_scene(glb);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error.find(glb.string() + ": mesh 'grid': blend shape 'odd': vertex "), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("displacement is not finite"), std::string::npos) << r.error;
+  EXPECT_EQ(r.error.find('\n'), std::string::npos);
 }
 
 // FBX blend shapes through assimp's exporter and reader (both with quadlod's repairs): names,

@@ -512,6 +512,9 @@ class SceneBuilder {
           set[k][w] = 1;
           const aiVector3D d = am->mVertices[v] - a.mVertices[v];
           out[k].displacement[w] = Vec3(d.x, d.y, d.z);
+          if (!out[k].displacement[w].allFinite() && error_.empty())
+            error_ = "mesh '" + fbx::printable(a.mName.C_Str()) + "': blend shape '" + fbx::printable(am->mName.C_Str()) +
+                     "': vertex " + std::to_string(v) + ": displacement is not finite";
         }
       }
     }
@@ -627,7 +630,9 @@ class SceneBuilder {
   const aiScene& ai_;
   const double normal_weld_cos_;
   const fbx::GeometryRead* fbx_;
+  std::string error_;  // issue 34: the first bad blend shape value (the read fails with it)
  public:
+  const std::string& error() const { return error_; }
   /// Issue 34: a binary FBX's blend shape channels' DeformPercent by channel name (assimp 5.2
   /// hands over FullWeights, not the channel's current value, which Blender writes there).
   std::map<std::string, double> fbx_deform_percent;
@@ -676,6 +681,11 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
   SceneBuilder builder(*ai, options, use ? &geometries : nullptr);
   if (fbx::is_binary_fbx(bytes)) builder.fbx_deform_percent = read_fbx_deform_percent(*ai, bytes);
   result.scene = builder.build();
+  if (!builder.error().empty()) {
+    result = SceneReadResult{};
+    result.error = name + ": " + builder.error();
+    return result;
+  }
   if (!note.empty()) result.scene.fbx_note = note;
   return result;
 }
