@@ -202,14 +202,15 @@ TEST(Morph, ABendingShapeChargesOnlyTheRegionItBends) {
   EXPECT_NEAR(error_at(q, outside, mesh.positions[outside] + step), base_outside, 1e-6 * base_outside);
 }
 
-// The selection keeps what the shape needs: in the bulging shape, the LOD with the shape term has
-// a smaller Hausdorff to the shaped input than the LOD that sees the flat base only (which has
-// nothing to keep anywhere on a flat grid).
+// The selection keeps what the shape needs: in the bulging shape, the LOD with the shape term is
+// closer to the shaped input than the LOD that sees the flat base only (which has nothing to keep
+// anywhere on a flat grid). Measured: Chamfer 7.4e-4 against 1.5e-3, Hausdorff 2.4e-2 against
+// 3.5e-2 (docs/blend_shapes.md).
 TEST(Morph, TheErrorTermKeepsTheShapesRegion) {
   PolyMesh input = make_grid(24, 24);
   input.morph_targets.push_back(bulge(input, "bulge"));
   const PolyMesh shaped_input = apply_morph_target(input, 0);
-  auto shaped_hausdorff = [&](double weight) {
+  auto shaped_error = [&](double weight) {
     SimplifyOptions options;
     options.ratio = 0.2;
     options.morph_error_weight = weight;
@@ -219,10 +220,11 @@ TEST(Morph, TheErrorTermKeepsTheShapesRegion) {
     ep.samples = 20000;
     const EvalResult e = evaluate(shaped_input, apply_morph_target(r.mesh, 0), ep);
     EXPECT_TRUE(e.ok()) << e.error;
-    return e.hausdorff;
+    return e;
   };
-  const double without = shaped_hausdorff(0.0), with = shaped_hausdorff(1.0);
-  EXPECT_LT(with, 0.75 * without) << "with " << with << ", without " << without;
+  const EvalResult without = shaped_error(0.0), with = shaped_error(1.0);
+  EXPECT_LT(with.chamfer, 0.6 * without.chamfer) << "with " << with.chamfer << ", without " << without.chamfer;
+  EXPECT_LT(with.hausdorff, without.hausdorff) << "with " << with.hausdorff << ", without " << without.hausdorff;
 }
 
 // --- passes, chains, scenes ------------------------------------------------------------------------
