@@ -209,6 +209,27 @@ PolyMesh mesh_from_arrays(const py::handle& vertices, const py::handle& faces, c
   return mesh;
 }
 
+void read_morph_targets(PolyMesh& mesh, const py::handle& morph_targets) {
+  if (is_none(morph_targets)) return;
+  if (!py::isinstance<py::dict>(morph_targets))
+    throw MeshInputError{"morph_targets: a dict {name: (V, 3) displacements}"};
+  for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(morph_targets)) {
+    MorphTarget& t = mesh.morph_targets.emplace_back();
+    t.name = py::str(key);
+    const std::string what = "morph_targets['" + t.name + "']";
+    const NumberArray a(value, what);
+    a.require_shape(2, 3, "(V, 3)");
+    if (a.rows() != py::ssize_t(mesh.num_vertices()))
+      throw MeshInputError{what + ": " + std::to_string(a.rows()) + " rows for " + std::to_string(mesh.num_vertices()) +
+                           " vertices"};
+    t.displacement.resize(mesh.num_vertices());
+    for (py::ssize_t i = 0; i < a.rows(); ++i) {
+      t.displacement[i] = Vec3(a.value(i, 0), a.value(i, 1), a.value(i, 2));
+      if (!t.displacement[i].allFinite()) throw MeshInputError{what + ": vertex " + std::to_string(i) + " is not finite"};
+    }
+  }
+}
+
 PolyMesh mesh_from_object(const py::handle& mesh) {
   if (py::isinstance<py::dict>(mesh)) {
     const py::dict d = py::reinterpret_borrow<py::dict>(mesh);
@@ -219,7 +240,9 @@ PolyMesh mesh_from_object(const py::handle& mesh) {
       throw MeshInputError{"mesh: a dict needs the keys 'vertices' and 'faces'"};
     py::object faces = get("faces");
     if (!get("face_sizes").is_none()) faces = py::make_tuple(faces, get("face_sizes"));
-    return mesh_from_arrays(get("vertices"), faces, get("uvs"), get("normals"), get("materials"));
+    PolyMesh out = mesh_from_arrays(get("vertices"), faces, get("uvs"), get("normals"), get("materials"));
+    read_morph_targets(out, get("morph_targets"));  // issue 34
+    return out;
   }
   if (py::isinstance<py::tuple>(mesh)) {
     const py::tuple t = py::reinterpret_borrow<py::tuple>(mesh);
@@ -277,6 +300,17 @@ py::dict mesh_to_dict(const PolyMesh& mesh, bool uvs_as_dict) {
       m(f) = slot;
     }
     out["materials"] = materials;
+  }
+  if (!mesh.morph_targets.empty()) {  // issue 34: blend shapes
+    py::dict shapes;
+    for (const MorphTarget& t : mesh.morph_targets) {
+      py::array_t<double> d({nv, py::ssize_t(3)});
+      auto w = d.mutable_unchecked<2>();
+      for (py::ssize_t i = 0; i < nv; ++i)
+        for (int k = 0; k < 3; ++k) w(i, k) = t.displacement[i][k];
+      shapes[py::str(t.name)] = d;
+    }
+    out["morph_targets"] = shapes;
   }
   return out;
 }

@@ -37,6 +37,11 @@ struct MeshInputError {
 PolyMesh mesh_from_arrays(const py::handle& vertices, const py::handle& faces, const py::handle& uvs,
                           const py::handle& normals, const py::handle& materials);
 
+/// Blend shapes (issue 34): `morph_targets` is None or a dict {shape name: (V, 3) displacements,
+/// one row per vertex} (Blender: shape key co − basis co); they go into mesh.morph_targets in the
+/// dict's order. Throws MeshInputError naming the shape on a wrong shape or a non-finite value.
+void read_morph_targets(PolyMesh& mesh, const py::handle& morph_targets);
+
 /// The same from a dict with the keys "vertices", "faces" (and optionally "face_sizes", "uvs",
 /// "normals", "materials") — what simplify() returns — or a tuple (vertices, faces).
 PolyMesh mesh_from_object(const py::handle& mesh);
@@ -44,7 +49,7 @@ PolyMesh mesh_from_object(const py::handle& mesh);
 /// The mesh as a dict of NumPy arrays: "vertices" (V,3) float64, "faces" (C,) int32 corner
 /// vertices, "face_sizes" (F,) int32, and when present "uvs" (per corner (C,2), NaN where a corner
 /// has none; a dict by layer name when `uvs_as_dict`), "normals" (C,3), "materials" (F,) int32
-/// (-1 = none).
+/// (-1 = none), "morph_targets" ({name: (V,3) float64 displacements}, issue 34).
 py::dict mesh_to_dict(const PolyMesh& mesh, bool uvs_as_dict);
 
 }  // namespace quadlod::python

@@ -91,6 +91,7 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"recover_quads", set_choice(&SimplifyOptions::recover_quads, "recover_quads", quad_recovery_names())},
       {"seams", set_choice(&SimplifyOptions::seams, "seams", seam_policy_names())},
       {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
+      {"morph_weight", set_field(&SimplifyOptions::morph_error_weight)},  // issue 34
       {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},
       {"consistency", set_field(&SimplifyOptions::consistency)},
       {"segmentation", set_field(&SimplifyOptions::segmentation)},
@@ -132,6 +133,7 @@ void check_ranges(const SimplifyOptions& o) {
   in(o.surface_fit_iterations, 0, 100, "surface_fit");
   in(o.surface_fit_vertex_weight, 0.0, 100.0, "surface_fit_vertex_weight");
   in(o.symmetry_tolerance, 1e-9, 0.1, "symmetry_tolerance");  // issue 34
+  in(o.morph_error_weight, 0.0, 100.0, "morph_weight");  // issue 34
 }
 
 SimplifyOptions options_from_kwargs(const py::kwargs& kwargs) {
@@ -291,35 +293,38 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "simplify",
       [](py::object vertices, py::object faces, py::object ratio, py::object faces_target, py::object uvs,
-         py::object normals, py::object materials, py::kwargs kwargs) {
+         py::object normals, py::object materials, py::object morph_targets, py::kwargs kwargs) {
         SimplifyOptions options = options_from_kwargs(kwargs);
         set_target(options, ratio, faces_target);
         check_ranges(options);
-        const PolyMesh mesh = mesh_from_arrays(vertices, faces, uvs, normals, materials);
+        PolyMesh mesh = mesh_from_arrays(vertices, faces, uvs, normals, materials);
+        read_morph_targets(mesh, morph_targets);  // issue 34
         return result_to_dict(run_simplify(mesh, options), py::isinstance<py::dict>(uvs));
       },
       py::arg("vertices"), py::arg("faces"), py::kw_only(), py::arg("ratio") = py::none(),
       py::arg("faces_target") = py::none(), py::arg("uvs") = py::none(), py::arg("normals") = py::none(),
-      py::arg("materials") = py::none(),
+      py::arg("materials") = py::none(), py::arg("morph_targets") = py::none(),
       R"(Reduces a polygon mesh, keeping its quad layout (the CLI's `quadlod simplify`).
 
 vertices: (V, 3) floats. faces: (corner_vertices, face_sizes) — flat corner indices and the
 corner count of each face, as Blender and trimesh hold polygons — or an (F, k) array.
 ratio: target as a fraction of the input's triangle-equivalents (quad = 2, k-gon = k - 2), or
 faces_target: that count. uvs: per-corner (C, 2) or {name: (C, 2)}; normals: per-corner (C, 3);
-materials: per-face slot index (F,). Further keywords are the CLI's options with '_' for '-'
+materials: per-face slot index (F,). morph_targets: blend shapes, {name: (V, 3) per-vertex
+displacements} (Blender: shape key co - basis co), carried to the output's vertices and counted
+in the error with weight morph_weight (docs/blend_shapes.md). Further keywords are the CLI's options with '_' for '-'
 (objective, effort, time_limit, time_bound, threads, seed, features, hard_angle, max_hausdorff, pass_ratio,
 surface_fit, surface_fit_vertex_weight, ...). protect: one weight per vertex in [0, 1] (V,) — 1 keeps
 the vertex exactly and the edges between such vertices, between 0 and 1 makes collapses there
 cost more (docs/protect.md); or protect_from='color:r' (the vertex colours' channel).
-Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials, protect] of the reduced mesh and
+Returns a dict: vertices, faces, face_sizes, [uvs, normals, materials, protect, morph_targets] of the reduced mesh and
 report (the JSON report of `simplify --report`, plus target/achieved/quads/triangles/ngons).
 Raises QuadlodError with the CLI's message on bad input.)");
 
   m.def(
       "lod_chain",
       [](py::object vertices, py::object faces, py::object ratios, int levels, double ratio, py::object uvs,
-         py::object normals, py::object materials, bool measure_hausdorff, py::kwargs kwargs) {
+         py::object normals, py::object materials, py::object morph_targets, bool measure_hausdorff, py::kwargs kwargs) {
         SimplifyOptions options = options_from_kwargs(kwargs);
         std::vector<double> chain;
         if (!ratios.is_none()) chain = ratios.cast<std::vector<double>>();
@@ -334,7 +339,8 @@ Raises QuadlodError with the CLI's message on bad input.)");
             throw py::value_error("ratios: each in (0, 1) and below the previous level's");
         options.ratio = chain.front();
         check_ranges(options);
-        const PolyMesh mesh = mesh_from_arrays(vertices, faces, uvs, normals, materials);
+        PolyMesh mesh = mesh_from_arrays(vertices, faces, uvs, normals, materials);
+        read_morph_targets(mesh, morph_targets);  // issue 34
         py::list out;
         for (const ChainLevel& level : run_lod_chain(mesh, chain, options, measure_hausdorff)) {
           py::dict d = result_to_dict(level.result, py::isinstance<py::dict>(uvs));
@@ -346,7 +352,7 @@ Raises QuadlodError with the CLI's message on bad input.)");
       },
       py::arg("vertices"), py::arg("faces"), py::kw_only(), py::arg("ratios") = py::none(), py::arg("levels") = 3,
       py::arg("ratio") = 0.5, py::arg("uvs") = py::none(), py::arg("normals") = py::none(),
-      py::arg("materials") = py::none(), py::arg("measure_hausdorff") = true,
+      py::arg("materials") = py::none(), py::arg("morph_targets") = py::none(), py::arg("measure_hausdorff") = true,
       R"(An LOD chain: a list of simplify() results, level k reduced from level k - 1.
 
 ratios: each level's size as a fraction of the INPUT's triangle-equivalents, decreasing

@@ -24,6 +24,7 @@ struct BatchCliOptions {
   std::string protect_from;  // issue 34
   int threads = -1;
   std::string symmetry;  // issue 34
+  double morph_weight = -1.0;  // issue 34: blend shapes (< 0 = the default)
 };
 
 }  // namespace
@@ -58,6 +59,8 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--protect-from", opt->protect_from,
                   "Protect weights from a vertex colour channel (as in simplify; a manifest line's \"protect\": FILE names a weight file)")
       ->check(CLI::IsMember({"none", "color:r", "color:g", "color:b"}));  // issue 34
+  sub->add_option("--morph-weight", opt->morph_weight, "Blend shapes: weight of each shape's geometry in the error, against the base's 1 (0 = the base alone; docs/blend_shapes.md)")
+      ->check(CLI::Range(0.0, 100.0));
   sub->add_option("--shard", opt->shard,
                   "Run shard I of N (0 <= I < N): asset i belongs to shard i mod N, e.g. "
                   "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT or $JOB_COMPLETION_INDEX/N")
@@ -82,6 +85,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (opt->no_features) defaults["features"] = false;
             if (!opt->protect_from.empty()) defaults["protect_from"] = opt->protect_from;  // issue 34
             if (!opt->symmetry.empty()) defaults["symmetry"] = opt->symmetry;
+            if (opt->morph_weight >= 0.0) defaults["morph_weight"] = opt->morph_weight;  // issue 34
             const bool folder = std::filesystem::is_directory(opt->source);
             if (folder && opt->output_dir.empty()) {
               std::fprintf(stderr, "quadlod batch: folder mode needs -o OUTDIR\n");

@@ -64,6 +64,9 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-features", opt->no_features, "Do not protect UV seams, material borders, boundaries, hard edges")
       ->group("Reduction");
   add_protect_options(sub, opt->protect_file, p);  // issue 34
+  // --- blend shapes (issue 34) ---
+  sub->add_option("--morph-weight", p.morph_error_weight, "Blend shapes: weight of each shape's geometry in the error, against the base's 1 (0 = the base alone; docs/blend_shapes.md)")
+      ->check(CLI::Range(0.0, 100.0))->capture_default_str()->group("Reduction");
   sub->add_flag("--no-hausdorff", opt->no_hausdorff, "Skip the Hausdorff measurement (and the screen sizes)")->group("Measurement");
   sub->add_option("--hausdorff-samples", opt->chain.hausdorff_samples, "Surface samples per direction of the Hausdorff measurement")
       ->check(CLI::Range(std::uint64_t{100}, std::uint64_t{100000000}))->capture_default_str()->group("Measurement");

@@ -188,6 +188,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                   "Which bones --skin-border separates: any two dominant joints, or unrelated ones only (parent and child may merge)")
       ->check(CLI::IsMember({"any", "unrelated"}))
       ->capture_default_str();
+  // --- blend shapes (issue 34) ---
+  sub->add_option("--morph-weight", p.morph_error_weight,
+                  "Blend shapes: weight of each shape's geometry in the error, against the base's 1 (0 = the base alone; docs/blend_shapes.md)")
+      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
   sub->add_option("--max-memory", opt->max_memory,
                   "Refuse (exit 2) an input whose estimated peak memory exceeds this (e.g. 2GiB, 512MB; 0 = no bound)")
       ->transform(CLI::AsSizeValue(false))->group("Guarantees");

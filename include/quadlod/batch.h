@@ -22,7 +22,8 @@ namespace quadlod {
 ///   "seed": n, "features": bool,
 ///   "recover_quads": "auto" | "on" | "off" → as the CLI's options of the same names;
 ///   "protect": FILE (relative to the manifest), "protect_from": "color:r" | … → as the CLI's
-///                                     --protect / --protect-from (issue 34, docs/protect.md).
+///                                     --protect / --protect-from (issue 34, docs/protect.md);
+///   "morph_weight": w (issue 34: blend shapes) → as the CLI's --morph-weight.
 /// Unknown keys are an error of that job (a typo must not silently change the run).
 struct BatchJob {
   std::filesystem::path input;

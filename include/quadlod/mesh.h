@@ -79,6 +79,15 @@ struct SkinWeights {
   std::string check(Index vertices) const;
 };
 
+/// A blend shape (issue 34; glTF morph target, FBX blend shape channel, Blender shape key): one
+/// displacement per vertex, added to the base positions at full weight. docs/blend_shapes.md.
+/// The OBJ / PLY / OFF paths ignore blend shapes.
+struct MorphTarget {
+  std::string name;                 ///< "" when the file gives none
+  double default_weight = 0.0;      ///< glTF `mesh.weights[k]`; FBX DeformPercent / 100
+  std::vector<Vec3> displacement;   ///< per vertex, in the mesh's own space (same units as positions)
+};
+
 /// A polygon mesh with optional per-corner UVs and normals and per-face tags.
 ///
 /// Invariants (checked by `check_layout()`):
@@ -90,7 +99,8 @@ struct SkinWeights {
 ///   * face_object / face_group / face_material / face_smoothing are empty or one per face;
 ///     the first three index their name tables or are kInvalidIndex; smoothing 0 means "off";
 ///   * vertex_colors is empty or one per vertex;
-///   * skin is empty or covers every vertex in canonical form (SkinWeights::check).
+///   * skin is empty or covers every vertex in canonical form (SkinWeights::check);
+///   * every morph target has one finite displacement per vertex.
 struct PolyMesh {
   // --- geometry -------------------------------------------------------------------------
   std::vector<Vec3> positions;
@@ -117,6 +127,9 @@ struct PolyMesh {
 
   // --- skinning (issue 24) ----------------------------------------------------------------------
   SkinWeights skin;  ///< per-vertex joint influences; empty when the mesh is not skinned
+
+  // --- blend shapes (issue 34) ----------------------------------------------------------------
+  std::vector<MorphTarget> morph_targets;  ///< empty when the mesh has none
 
   // --- sizes ----------------------------------------------------------------------------------
   Index num_vertices() const { return static_cast<Index>(positions.size()); }

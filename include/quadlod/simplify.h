@@ -260,6 +260,14 @@ struct SimplifyOptions {
   /// a smart-UV-projected mirror model 0.45, where mirroring cost +42 % Chamfer at 0.4
   /// (docs/symmetry.md, "Attributes").
   double symmetry_min_mirrored_lines = 0.9;
+  // --- blend shapes (issue 34; docs/blend_shapes.md) --------------------------------------------
+  /// With blend shapes (PolyMesh::morph_targets), the output gets each shape's displacements by
+  /// the skin weights' projection onto the input (transfer_morph_targets, quadlod/morph.h), and
+  /// the vertex quadrics that price and place every cluster count each shape's geometry with this
+  /// weight against the base's 1 (src/morph/morph_quadrics.h): a region a shape deforms keeps the
+  /// resolution the shape needs. 0 = the base alone decides (the shapes are still carried). The
+  /// CLI's --morph-weight; the default is measured in docs/blend_shapes.md.
+  double morph_error_weight = 1.0;
 };
 
 // The choices of SimplifyOptions by name, for the CLI, manifests and Python; the names are the

@@ -46,6 +46,8 @@ struct SkinnedReadResult {
 /// a channel on a joint becomes an Animation (other channels are counted in ignored_channels).
 /// Files written by write_skinned_glb carry each primitive's polygon sizes in
 /// extras.quadlod_polygon_sizes; their polygons are rebuilt from the fans (quads read back as quads).
+/// Morph targets (issue 34) become mesh.morph_targets: POSITION displacements, names from the
+/// mesh's extras.targetNames, default weights from its `weights`.
 /// Rejects: unreadable file, malformed JSON / chunks, out-of-range accessors, sparse accessors,
 /// non-triangle primitives, no skinned mesh node.
 SkinnedReadResult read_skinned_gltf(const std::filesystem::path& path);
@@ -55,6 +57,8 @@ SkinnedReadResult read_skinned_gltf(const std::filesystem::path& path);
 /// holding skeleton.root_transform, one primitive per material (fan-triangulated polygons,
 /// vertices split per (vertex, UV, normal) corner, JOINTS_n / WEIGHTS_n in sets of four, weights
 /// renormalised in float; the polygon sizes in the primitive's extras), one glTF animation per Animation (LINEAR or STEP samplers).
+/// mesh.morph_targets (issue 34) become morph targets of every primitive, with the mesh's
+/// `weights` and extras.targetNames (the names Blender gives the shape keys).
 /// `material_colors` gives base colours by material name (others are grey). Precondition:
 /// mesh.check_layout() and rig.skeleton.check() are empty and mesh.skin is not empty;
 /// otherwise an error. Written atomically (write_file_atomically).

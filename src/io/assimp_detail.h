@@ -15,4 +15,9 @@ SceneReadResult read_scene_with_assimp(const std::filesystem::path& path, const 
 bool format_scene_with_assimp(const Scene& scene, const char* format_id, bool triangulate,
                               std::string& out, std::string& error);
 
+/// Issue 34: adds glTF's `mesh.weights` (the blend shapes' default weights, which assimp 5.2's
+/// exporter does not write) to a .glb assimp wrote for `scene` (src/io/gltf_morph_weights.cpp).
+/// Unchanged when no mesh has shapes; false when `glb` is not a GLB with a JSON chunk.
+bool add_gltf_morph_weights(const Scene& scene, std::string& glb);
+
 }  // namespace quadlod::io_detail

@@ -175,6 +175,7 @@ class SceneBuilder {
     Index id = kInvalidIndex;
     if (out.mesh.num_faces() > 0) {
       for (unsigned m : group) per_mesh_extras(*ai_.mMeshes[m], out);
+      read_morph_targets(group, out.mesh);
       id = static_cast<Index>(scene_.meshes.size());
       scene_.meshes.push_back(std::move(out));
     }
@@ -471,6 +472,56 @@ class SceneBuilder {
     mesh.skin = make_skin_weights(lists);
   }
 
+  /// Issue 34: the blend shapes of a group's aiMeshes (aiMesh::mAnimMeshes, absolute positions
+  /// per aiMesh vertex) as per-vertex displacements of the welded mesh. Target k of every aiMesh
+  /// of the group is one MorphTarget (glTF: every primitive of a mesh has the same targets; FBX:
+  /// one channel per shape), named by the first aiMesh that names it. A welded vertex takes its
+  /// displacement from the first aiMesh vertex that maps onto it (the corners of one vertex split
+  /// at a UV seam carry the same shape). The default weight is glTF's `mesh.weights`; for a
+  /// binary FBX the channel's DeformPercent / 100 (fbx_deform_percent: assimp's reader gives the
+  /// channel's full weight instead, 1), else 0. Anim meshes without positions give no target.
+  void read_morph_targets(const std::vector<unsigned>& group, PolyMesh& mesh) {
+    unsigned targets = 0;
+    for (unsigned m : group) targets = std::max(targets, ai_.mMeshes[m]->mNumAnimMeshes);
+    if (targets == 0) return;
+    const bool gltf = source_is_gltf();
+    std::vector<MorphTarget> out(targets);
+    std::vector<char> has_positions(targets, 0);
+    for (MorphTarget& t : out) t.displacement.assign(mesh.num_vertices(), Vec3::Zero());
+    std::vector<std::vector<char>> set(targets, std::vector<char>(mesh.num_vertices(), 0));
+    for (unsigned m : group) {
+      const aiMesh& a = *ai_.mMeshes[m];
+      const auto recorded = welded_of_.find(&a);
+      if (recorded == welded_of_.end()) continue;  // no face of `a` survived the weld
+      const std::vector<Index>& welded_of = recorded->second;
+      for (unsigned k = 0; k < a.mNumAnimMeshes; ++k) {
+        const aiAnimMesh* am = a.mAnimMeshes[k];
+        if (!am || !am->mVertices || am->mNumVertices != a.mNumVertices) continue;
+        has_positions[k] = 1;
+        if (out[k].name.empty() && am->mName.length > 0) {
+          out[k].name = am->mName.C_Str();
+          if (gltf) out[k].default_weight = am->mWeight;
+          if (const auto it = fbx_deform_percent.find(out[k].name); it != fbx_deform_percent.end())
+            out[k].default_weight = it->second / 100.0;
+        } else if (gltf && out[k].default_weight == 0.0) {
+          out[k].default_weight = am->mWeight;
+        }
+        for (unsigned v = 0; v < a.mNumVertices; ++v) {
+          const Index w = welded_of[v];
+          if (w == kInvalidIndex || set[k][w]) continue;
+          set[k][w] = 1;
+          const aiVector3D d = am->mVertices[v] - a.mVertices[v];
+          out[k].displacement[w] = Vec3(d.x, d.y, d.z);
+          if (!out[k].displacement[w].allFinite() && error_.empty())
+            error_ = "mesh '" + fbx::printable(a.mName.C_Str()) + "': blend shape '" + fbx::printable(am->mName.C_Str()) +
+                     "': vertex " + std::to_string(v) + ": displacement is not finite";
+        }
+      }
+    }
+    for (unsigned k = 0; k < targets; ++k)
+      if (has_positions[k]) mesh.morph_targets.push_back(std::move(out[k]));
+  }
+
   /// The joint of a bone name, created on first use with the bone's offset matrix as B⁻¹.
   Index joint_of(const std::string& name, const Eigen::Matrix4d& inverse_bind) {
     auto [it, inserted] = joint_index_.try_emplace(name, static_cast<Index>(scene_.rig.skeleton.joints.size()));
@@ -579,6 +630,13 @@ class SceneBuilder {
   const aiScene& ai_;
   const double normal_weld_cos_;
   const fbx::GeometryRead* fbx_;
+  std::string error_;  // issue 34: the first bad blend shape value (the read fails with it)
+ public:
+  const std::string& error() const { return error_; }
+  /// Issue 34: a binary FBX's blend shape channels' DeformPercent by channel name (assimp 5.2
+  /// hands over FullWeights, not the channel's current value, which Blender writes there).
+  std::map<std::string, double> fbx_deform_percent;
+ private:
   Scene scene_;
   std::map<std::vector<unsigned>, Index> mesh_of_group_;
   std::map<std::string, Index> joint_index_;  // issue 24: joint of each bone name
@@ -598,6 +656,8 @@ void configure(Assimp::Importer& importer) {
 /// `bytes`: the file's bytes when it may be a binary FBX (else empty): its control points give
 /// the meshes their vertices (fbx_control_points.h). A binary FBX that assimp reads but our
 /// parser refuses, or one written by assimp, is glued as before, with Scene::fbx_note saying why.
+std::map<std::string, double> read_fbx_deform_percent(const aiScene& ai, std::string_view bytes);
+
 SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std::string& name,
                        const SceneReadOptions& options, std::string_view bytes) {
   SceneReadResult result;
@@ -618,9 +678,38 @@ SceneReadResult finish(const aiScene* ai, Assimp::Importer& importer, const std:
       note = "FBX written by assimp (per-corner control points); corners glued along edges";
   }
   const bool use = binary_fbx && note.empty();
-  result.scene = SceneBuilder(*ai, options, use ? &geometries : nullptr).build();
+  SceneBuilder builder(*ai, options, use ? &geometries : nullptr);
+  if (fbx::is_binary_fbx(bytes)) builder.fbx_deform_percent = read_fbx_deform_percent(*ai, bytes);
+  result.scene = builder.build();
+  if (!builder.error().empty()) {
+    result = SceneReadResult{};
+    result.error = name + ": " + builder.error();
+    return result;
+  }
   if (!note.empty()) result.scene.fbx_note = note;
   return result;
+}
+
+/// Issue 34: DeformPercent of every BlendShapeChannel of a binary FBX, by channel name (the
+/// name before the "\0\1" class separator); empty when no aiMesh has blend shapes (the file is
+/// not parsed again) or the record tree does not parse.
+std::map<std::string, double> read_fbx_deform_percent(const aiScene& ai, std::string_view bytes) {
+  std::map<std::string, double> out;
+  bool shapes = false;
+  for (unsigned m = 0; m < ai.mNumMeshes; ++m) shapes = shapes || ai.mMeshes[m]->mNumAnimMeshes > 0;
+  if (!shapes) return out;
+  const fbx::ParseResult parsed = fbx::parse_binary_fbx(bytes);
+  const fbx::Record* objects = parsed.ok() ? parsed.document.find("Objects") : nullptr;
+  if (!objects) return out;
+  for (const fbx::Record& r : objects->children) {
+    if (r.name != "Deformer" || r.string_property(2) != "BlendShapeChannel") continue;
+    const fbx::Record* percent = r.find("DeformPercent");
+    if (!percent || percent->properties.empty() || percent->properties[0].reals.empty()) continue;
+    std::string name = r.string_property(1);
+    name = name.substr(0, name.find(std::string_view("\0\1", 2)));
+    out.try_emplace(name, percent->properties[0].reals[0]);
+  }
+  return out;
 }
 
 /// The file's bytes when it starts with the binary FBX magic, else "".

@@ -281,6 +281,13 @@ SkinnedReadResult read_impl(const std::filesystem::path& path) {
   struct Corner { Index vertex, uv, normal; };
   std::vector<std::vector<Corner>> polygons;
   std::vector<Index> polygon_material;
+  // Blend shapes (issue 34): glTF morph targets' POSITION displacements, target k of every
+  // primitive being the mesh's shape k; a welded vertex keeps the first displacement it was
+  // given (the glTF vertices of one welded vertex, split at UV / normal seams, carry the same).
+  std::size_t num_targets = 0;
+  for (const json& prim : gmesh["primitives"])
+    if (prim.contains("targets") && prim["targets"].is_array()) num_targets = std::max(num_targets, prim["targets"].size());
+  std::vector<std::vector<Vec3>> shapes(num_targets);
   for (std::size_t pi = 0; pi < gmesh["primitives"].size(); ++pi) {
     const json& prim = gmesh["primitives"][pi];
     const std::string where = "mesh primitive " + std::to_string(pi);
@@ -293,6 +300,13 @@ SkinnedReadResult read_impl(const std::filesystem::path& path) {
     if (attr.contains("TEXCOORD_0")) uv = doc.read(attr["TEXCOORD_0"].get<std::size_t>(), 2);
     if (attr.contains("NORMAL")) nor = doc.read(attr["NORMAL"].get<std::size_t>(), 3);
     if ((!uv.empty() && uv.size() != 2 * nv) || (!nor.empty() && nor.size() != 3 * nv)) doc.fail(where + ": attribute counts differ");
+    std::vector<std::vector<double>> shape_of(num_targets);  // this primitive's targets (empty: none)
+    for (std::size_t k = 0; k < num_targets && prim.contains("targets") && k < prim["targets"].size(); ++k) {
+      const json& target = prim["targets"][k];
+      if (!target.contains("POSITION")) continue;
+      shape_of[k] = doc.read(target["POSITION"].get<std::size_t>(), 3);
+      if (shape_of[k].size() != 3 * nv) doc.fail(where + ": morph target " + std::to_string(k) + " count differs from POSITION");
+    }
     std::vector<std::vector<Influence>> vertex_influences(nv);
     for (int set = 0;; ++set) {
       const std::string js = "JOINTS_" + std::to_string(set), ws = "WEIGHTS_" + std::to_string(set);
@@ -316,6 +330,9 @@ SkinnedReadResult read_impl(const std::filesystem::path& path) {
       if (fresh) {
         mesh.add_vertex(Vec3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]));
         influences.push_back(canon);
+        for (std::size_t k = 0; k < num_targets; ++k)
+          shapes[k].push_back(shape_of[k].empty() ? Vec3::Zero()
+                                                  : Vec3(shape_of[k][3 * v], shape_of[k][3 * v + 1], shape_of[k][3 * v + 2]));
       }
       vertex_id[v] = it->second;
       if (!uv.empty()) {
@@ -413,6 +430,17 @@ SkinnedReadResult read_impl(const std::filesystem::path& path) {
     }
   }
   mesh.skin = make_skin_weights(influences);
+  for (std::size_t k = 0; k < num_targets; ++k) {
+    MorphTarget t;
+    if (gmesh.contains("extras") && gmesh["extras"].is_object() && gmesh["extras"].contains("targetNames") &&
+        gmesh["extras"]["targetNames"].is_array() && k < gmesh["extras"]["targetNames"].size() &&
+        gmesh["extras"]["targetNames"][k].is_string())
+      t.name = gmesh["extras"]["targetNames"][k].get<std::string>();
+    if (gmesh.contains("weights") && gmesh["weights"].is_array() && k < gmesh["weights"].size() && gmesh["weights"][k].is_number())
+      t.default_weight = gmesh["weights"][k].get<double>();
+    t.displacement = std::move(shapes[k]);
+    mesh.morph_targets.push_back(std::move(t));
+  }
 
   // --- animations -------------------------------------------------------------------------------
   if (g.contains("animations"))

@@ -113,6 +113,7 @@ json mesh_primitives(const PolyMesh& mesh, BinaryBuilder& b, MaterialTable& tabl
   for (const auto& [material, faces] : faces_of) {
     std::map<std::tuple<Index, Index, Index>, std::uint32_t> vertex_of;
     std::vector<float> pos, nor, tex;
+    std::vector<std::vector<float>> shapes(mesh.morph_targets.size());  // issue 34: per target, xyz per vertex
     std::vector<std::uint16_t> joints;
     std::vector<float> weights;
     std::vector<std::uint32_t> indices, polygon_sizes;
@@ -124,6 +125,8 @@ json mesh_primitives(const PolyMesh& mesh, BinaryBuilder& b, MaterialTable& tabl
       auto [it, fresh] = vertex_of.try_emplace({v, uv, n}, static_cast<std::uint32_t>(pos.size() / 3));
       if (fresh) {
         for (int k = 0; k < 3; ++k) pos.push_back(static_cast<float>(mesh.positions[v][k]));
+        for (std::size_t t = 0; t < shapes.size(); ++t)
+          for (int k = 0; k < 3; ++k) shapes[t].push_back(static_cast<float>(mesh.morph_targets[t].displacement[v][k]));
         if (normals) {
           const Vec3 nv = n != kInvalidIndex ? mesh.normals[n].normalized() : Vec3::UnitZ();
           all_normals &= n != kInvalidIndex;
@@ -176,6 +179,13 @@ json mesh_primitives(const PolyMesh& mesh, BinaryBuilder& b, MaterialTable& tabl
       attributes["WEIGHTS_" + std::to_string(s)] = b.floats(ws, 4, "VEC4", 34962, false);
     }
     json prim = {{"attributes", attributes}, {"indices", b.u32(indices)}, {"mode", 4}};
+    // Blend shapes (issue 34): glTF morph targets, POSITION displacements (with min / max, which
+    // the specification requires of them as of POSITION).
+    if (!shapes.empty()) {
+      json targets = json::array();
+      for (const std::vector<float>& d : shapes) targets.push_back({{"POSITION", b.floats(d, 3, "VEC3", 34962, true)}});
+      prim["targets"] = std::move(targets);
+    }
     // The polygons behind the fans, so that quadlod reads its quads back (read_skinned_gltf);
     // viewers ignore extras.
     prim["extras"] = {{"quadlod_polygon_sizes", b.u32(polygon_sizes, 0)}};
@@ -222,8 +232,19 @@ WriteResult write_skinned_scene_glb(const std::vector<SkinnedGlbMesh>& meshes, c
   BinaryBuilder b;
   MaterialTable table;
   json gltf_meshes = json::array();
-  for (const SkinnedGlbMesh& m : meshes)
-    gltf_meshes.push_back({{"name", m.name}, {"primitives", mesh_primitives(*m.mesh, b, table, material_colors)}});
+  for (const SkinnedGlbMesh& m : meshes) {
+    json gm = {{"name", m.name}, {"primitives", mesh_primitives(*m.mesh, b, table, material_colors)}};
+    if (!m.mesh->morph_targets.empty()) {  // issue 34: default weights, and names as Blender reads them
+      json weights = json::array(), names = json::array();
+      for (const MorphTarget& t : m.mesh->morph_targets) {
+        weights.push_back(t.default_weight);
+        names.push_back(t.name);
+      }
+      gm["weights"] = std::move(weights);
+      gm["extras"] = {{"targetNames", std::move(names)}};
+    }
+    gltf_meshes.push_back(std::move(gm));
+  }
 
   // Nodes: 0 the rig root, 1 + j the joints, then the skinned meshes' nodes, then the others.
   const Skeleton& sk = rig.skeleton;

@@ -152,12 +152,17 @@ ReadResult read_mesh(const fs::path& path, const ReadOptions& options) {
 WriteResult write_mesh(const PolyMesh& mesh, const fs::path& path, const WriteOptions& options) {
   MeshFormat format{};
   if (!format_from_path(path, format)) return {"cannot write " + unknown_format_error(path), {}};
+  WriteResult r;
   switch (format) {
-    case MeshFormat::Obj: return write_obj(mesh, path, options);
-    case MeshFormat::Ply: return write_ply(mesh, path, options);
-    case MeshFormat::Off: return write_off(mesh, path, options);
+    case MeshFormat::Obj: r = write_obj(mesh, path, options); break;
+    case MeshFormat::Ply: r = write_ply(mesh, path, options); break;
+    case MeshFormat::Off: r = write_off(mesh, path, options); break;
   }
-  return {};
+  // Issue 34: none of the three holds blend shapes; say so instead of losing them silently.
+  if (r.ok() && !mesh.morph_targets.empty())
+    r.warnings.push_back(path.string() + ": " + std::to_string(mesh.morph_targets.size()) +
+                         " blend shape(s) dropped: OBJ, PLY and OFF hold none (write .glb or .fbx to keep them)");
+  return r;
 }
 
 WriteResult write_file_atomically(const fs::path& path, std::string_view contents) {

@@ -194,7 +194,14 @@ WriteResult write_scene(const Scene& scene, const std::filesystem::path& path, c
       result.error = path.string() + ": the scene has no mesh to write";
       return result;
     }
-    return one_mesh ? write_mesh(scene.meshes[0].mesh, path, options) : write_mesh(flatten_scene(scene), path, options);
+    if (one_mesh) return write_mesh(scene.meshes[0].mesh, path, options);  // warns of its blend shapes
+    WriteResult flat = write_mesh(flatten_scene(scene), path, options);
+    std::size_t shapes = 0;  // issue 34: flatten_scene keeps none
+    for (const SceneMesh& m : scene.meshes) shapes += m.mesh.morph_targets.size();
+    if (flat.ok() && shapes > 0)
+      flat.warnings.push_back(path.string() + ": " + std::to_string(shapes) +
+                              " blend shape(s) dropped: OBJ, PLY and OFF hold none (write .glb or .fbx to keep them)");
+    return flat;
   }
   // Issue 24: assimp's glTF exporter writes no skin; a skinned scene goes to quadlod's own.
   if (format == SceneFormat::Glb && io_detail::scene_is_skinned(scene)) return io_detail::write_skinned_scene(scene, path);
@@ -204,7 +211,14 @@ WriteResult write_scene(const Scene& scene, const std::filesystem::path& path, c
     result.error = path.string() + ": " + error;
     return result;
   }
-  return write_file_atomically(path, bytes);
+  result = write_file_atomically(path, bytes);
+  // Issue 34: assimp 5.2's Collada exporter writes no morph controllers.
+  std::size_t shapes = 0;
+  for (const SceneMesh& m : scene.meshes) shapes += m.mesh.morph_targets.size();
+  if (result.ok() && format == SceneFormat::Collada && shapes > 0)
+    result.warnings.push_back(path.string() + ": " + std::to_string(shapes) +
+                              " blend shape(s) dropped: assimp's Collada exporter writes none (write .glb or .fbx to keep them)");
+  return result;
 }
 
 }  // namespace quadlod

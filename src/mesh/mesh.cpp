@@ -81,6 +81,15 @@ std::string PolyMesh::check_layout() const {
         check_tags(face_material, material_names.size(), num_faces(), "material", true),
         check_tags(face_smoothing, 0, num_faces(), "smoothing", false), skin.check(num_vertices())})
     if (!s.empty()) return s;
+  // Blend shapes (issue 34): one finite displacement per vertex.
+  for (std::size_t k = 0; k < morph_targets.size(); ++k) {
+    const std::vector<Vec3>& d = morph_targets[k].displacement;
+    const std::string what = "morph target " + std::to_string(k) + " ('" + morph_targets[k].name + "')";
+    if (d.size() != positions.size())
+      return what + ": " + std::to_string(d.size()) + " displacements for " + std::to_string(positions.size()) + " vertices";
+    for (std::size_t v = 0; v < d.size(); ++v)
+      if (!d[v].allFinite()) return what + ": vertex " + std::to_string(v) + ": displacement is not finite";
+  }
   return {};
 }
 

@@ -38,7 +38,7 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                                                "objective", "time_limit", "threads", "seed", "features",
                                                "recover_quads", "seams",
                                                "protect", "protect_from",
-                                               "symmetry"};  // issue 34
+                                               "symmetry", "morph_weight"};  // issue 34
   if (!options.is_object()) return "options must be a JSON object";
   for (const auto& [key, value] : options.items())
     if (!kKnown.count(key)) return "unknown option '" + key + "'";
@@ -77,6 +77,10 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
       const auto symmetry = parse_symmetry(options["symmetry"].get<std::string>());
       if (!symmetry) return "symmetry must be auto, x, y, z or off";
       simplify.symmetry = *symmetry;
+    }
+    if (options.contains("morph_weight")) {  // issue 34: blend shapes
+      simplify.morph_error_weight = options["morph_weight"].get<double>();
+      if (!(simplify.morph_error_weight >= 0.0)) return "morph_weight must be >= 0";
     }
     if (options.contains("levels")) levels = options["levels"].get<std::vector<double>>();
     if (options.contains("count")) levels = lod_ratios_by_count(options["count"].get<int>());

@@ -18,6 +18,8 @@
 #include "select/shape_selection.h"
 #include "skin/skin_borders.h"
 #include "skin/pose_quadrics.h"
+#include "morph/morph_quadrics.h"
+#include "morph/morph_transfer.h"
 #include "quadlod/skin.h"
 #include "topology/analysis.h"
 #include "util/parallel.h"
@@ -344,6 +346,8 @@ PassOutcome reduce_pass(const PolyMesh& input, std::uint64_t target, double time
         quadrics = input.skin.empty() || options.skin_poses.empty()
                        ? build_vertex_quadrics(input, conn, placement)
                        : build_pose_vertex_quadrics(input, conn, placement, options.skin_poses);
+        // Issue 34: and in every blend shape (morph/morph_quadrics.h).
+        add_morph_quadrics(quadrics, input, conn, placement, options.morph_error_weight);
       });
   report["analysis"] = {
       {"seconds", out.seconds_analysis},
@@ -824,6 +828,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
   if (reference) cp.feature_reference = &*reference;
   PolyMesh current;
   const PolyMesh* pass_input = &input;
+  // Blend shapes (issue 34): every pass's output is projected onto the original input, whose
+  // search structures are built once (morph/morph_transfer.h).
+  std::optional<SurfaceProjector> shape_source;
+  if (!input.morph_targets.empty()) shape_source.emplace(input);
+  auto carry_shapes = [&](PolyMesh& mesh) {
+    if (shape_source) mesh.morph_targets = blend_morph_targets(input, mesh, shape_source->project(mesh));
+  };
   // Output face → original input face, composed over the passes (exact island accounting).
   std::vector<Index> face_origin(input.num_faces());
   std::iota(face_origin.begin(), face_origin.end(), Index{0});
@@ -922,6 +933,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     // Skin weights (issue 24): by projection onto the original input after every pass, so the
     // next pass sees its joint-influence borders and the output carries weights.
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
+    // Blend shapes (issue 34) by the same projection: the next pass prices them on its input.
+    carry_shapes(current);
     pass_input = &current;
     if (pass >= planned &&
         std::abs(double(last.achieved) - n) <= options.round_tolerance * n)
@@ -1018,6 +1031,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                              {"refused_far", fit.refused_far},
                              {"refused_line", fit.refused_line}};
     if (!input.skin.empty()) current.skin = transfer_skin_weights(input, current).skin;
+    carry_shapes(current);
     report["stage_seconds"]["fit"] = fit_clock.seconds();
   }
   if (output_mirror) {
@@ -1165,6 +1179,13 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
       {"symmetry_min_matched", options.symmetry_min_matched},
       {"symmetry_min_mirrored_lines", options.symmetry_min_mirrored_lines},
   };
+  // Issue 34: only for inputs with blend shapes, so other reports stay as they were.
+  if (!input.morph_targets.empty()) {
+    nlohmann::json names = nlohmann::json::array();
+    for (const MorphTarget& t : input.morph_targets) names.push_back(t.name);
+    report["options"]["morph_error_weight"] = options.morph_error_weight;
+    report["morph_targets"] = {{"count", input.morph_targets.size()}, {"names", std::move(names)}};
+  }
   log.done(5, "done", total.seconds(),
            "target " + std::to_string(result.target) + ", achieved " + std::to_string(result.achieved) +
                (result.passes_used > 1 ? " in " + std::to_string(result.passes_used) + " passes" : ""));

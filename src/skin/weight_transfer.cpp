@@ -12,6 +12,7 @@
 #include "quadlod/skin.h"
 
 #include "geometry/bvh.h"
+#include "skin/surface_projection.h"
 
 #include <algorithm>
 #include <cmath>
@@ -201,11 +202,12 @@ std::vector<Index> match_parts(const SourceSurface& source, const PolyMesh& targ
 
 }  // namespace
 
-SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
-                                         const SkinTransferParams& params) {
-  SkinTransferResult result;
-  SourceSurface surface(source, params);
-  const Index max_influences = params.max_influences > 0 ? params.max_influences : source.skin.max_influences();
+namespace {
+
+// One projection of `target` onto a built source surface (the part BVHs built when parts are
+// kept and the source has several).
+SurfaceProjection project_with(const SourceSurface& surface, const PolyMesh& target, const SkinTransferParams& params) {
+  SurfaceProjection result;
 
   // Area-weighted vertex normals of the target.
   std::vector<Vec3> vertex_normal(target.num_vertices(), Vec3::Zero());
@@ -219,12 +221,12 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
   result.parts = target_parts;
   std::vector<Index> matched(target_parts, kInvalidIndex);
   if (params.keep_parts && surface.parts > 1 && !surface.triangles.empty()) {
-    surface.build_part_bvhs();
     matched = match_parts(surface, target, target_part, target_parts, vertex_normal, params);
     for (Index m : matched) result.parts_matched += m != kInvalidIndex;
   }
 
-  std::vector<std::vector<Influence>> per_vertex(target.num_vertices());
+  result.corners.assign(target.num_vertices(), {kInvalidIndex, kInvalidIndex, kInvalidIndex});
+  result.barycentric.assign(target.num_vertices(), Vec3::Zero());
   double sum_distance = 0.0;
   Index hint = kInvalidIndex;
   std::vector<Index> part_hint(surface.part_bvh.size(), kInvalidIndex);
@@ -234,20 +236,65 @@ SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh&
     const NearestHit hit = surface.project(target.positions[v], vertex_normal[v], part,
                                            part == kInvalidIndex ? hint : part_hint[part], &same_side);
     ++(same_side ? result.same_side : result.nearest_only);
-    if (hit.primitive == kInvalidIndex) continue;  // empty source: no weights
-    const auto& c = surface.corners[hit.primitive];
+    if (hit.primitive == kInvalidIndex) continue;  // empty source: nothing to blend
     const auto& t = surface.triangles[hit.primitive];
-    const Vec3 bary = barycentric(hit.point, t[0], t[1], t[2]);
-    std::vector<Influence> blend;
-    for (int k = 0; k < 3; ++k)
-      if (bary[k] > 0.0)
-        for (const Influence& i : influences_of(source.skin, c[k])) blend.push_back({i.joint, bary[k] * i.weight});
-    per_vertex[v] = std::move(blend);
+    result.corners[v] = surface.corners[hit.primitive];
+    result.barycentric[v] = barycentric(hit.point, t[0], t[1], t[2]);
     const double d = std::sqrt(hit.distance_sq);
     result.max_distance = std::max(result.max_distance, d);
     sum_distance += d;
   }
   result.mean_distance = target.num_vertices() ? sum_distance / target.num_vertices() : 0.0;
+  return result;
+}
+
+bool keeps_parts(const SourceSurface& surface, const SkinTransferParams& params) {
+  return params.keep_parts && surface.parts > 1 && !surface.triangles.empty();
+}
+
+}  // namespace
+
+SurfaceProjection project_onto_surface(const PolyMesh& source, const PolyMesh& target, const SkinTransferParams& params) {
+  SourceSurface surface(source, params);
+  if (keeps_parts(surface, params)) surface.build_part_bvhs();
+  return project_with(surface, target, params);
+}
+
+struct SurfaceProjector::Surface : SourceSurface {
+  using SourceSurface::SourceSurface;
+};
+
+SurfaceProjector::SurfaceProjector(const PolyMesh& source, const SkinTransferParams& params)
+    : surface_(std::make_unique<Surface>(source, params)), params_(params) {
+  if (keeps_parts(*surface_, params_)) surface_->build_part_bvhs();
+}
+
+SurfaceProjector::~SurfaceProjector() = default;
+
+SurfaceProjection SurfaceProjector::project(const PolyMesh& target) const { return project_with(*surface_, target, params_); }
+
+SkinTransferResult transfer_skin_weights(const PolyMesh& source, const PolyMesh& target,
+                                         const SkinTransferParams& params) {
+  const SurfaceProjection projection = project_onto_surface(source, target, params);
+  SkinTransferResult result;
+  result.same_side = projection.same_side;
+  result.nearest_only = projection.nearest_only;
+  result.parts = projection.parts;
+  result.parts_matched = projection.parts_matched;
+  result.max_distance = projection.max_distance;
+  result.mean_distance = projection.mean_distance;
+  const Index max_influences = params.max_influences > 0 ? params.max_influences : source.skin.max_influences();
+  std::vector<std::vector<Influence>> per_vertex(target.num_vertices());
+  for (Index v = 0; v < target.num_vertices(); ++v) {
+    const auto& c = projection.corners[v];
+    if (c[0] == kInvalidIndex) continue;
+    const Vec3& bary = projection.barycentric[v];
+    std::vector<Influence> blend;
+    for (int k = 0; k < 3; ++k)
+      if (bary[k] > 0.0)
+        for (const Influence& i : influences_of(source.skin, c[k])) blend.push_back({i.joint, bary[k] * i.weight});
+    per_vertex[v] = std::move(blend);
+  }
   result.skin = make_skin_weights(per_vertex, max_influences, params.min_weight);
   return result;
 }

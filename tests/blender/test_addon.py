@@ -193,6 +193,30 @@ def main(zip_path):
         check(lod is not None and lod["quadlod_report"]["symmetry"] == "x",
               f"symmetry {axis}: the report names the x plane")
 
+    # Shape keys travel (issue 34): a grid whose key lifts one vertex gets LODs with the key, its
+    # value, and the lifted vertex lifted where it survives.
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=16, y_subdivisions=16, size=2.0, location=(0, 0, 10))
+    grid = bpy.context.active_object
+    grid.name = "Sheet"
+    grid.shape_key_add(name="Basis")
+    key = grid.shape_key_add(name="Lift")
+    lifted = min(range(len(grid.data.vertices)), key=lambda i: (grid.data.vertices[i].co.x - 0.25) ** 2 + grid.data.vertices[i].co.y ** 2)
+    key.data[lifted].co.z += 0.5
+    key.value = 0.3
+    bpy.ops.object.select_all(action="DESELECT")
+    grid.select_set(True)
+    bpy.context.view_layer.objects.active = grid
+    check(bpy.ops.object.quadlod_lod(levels=1, ratio=0.4) == {"FINISHED"}, "operator on the mesh with a shape key")
+    lod = bpy.data.objects.get("Sheet_LOD1")
+    keys = lod.data.shape_keys.key_blocks if lod is not None and lod.data.shape_keys else []
+    check([k.name for k in keys] == ["Basis", "Lift"], f"LOD has the shape keys ({[k.name for k in keys]})")
+    if len(keys) == 2:
+        check(abs(keys["Lift"].value - 0.3) < 1e-6, f"LOD key keeps its value ({keys['Lift'].value})")
+        moved = [(b.co, k.co) for b, k in zip(keys[0].data, keys[1].data) if (k.co - b.co).length > 1e-6]
+        top = max(((k - b).z for b, k in moved), default=0.0)
+        check(len(moved) > 0 and top <= 0.5 + 1e-6, f"LOD key moves {len(moved)} vertices, by up to {top:.3f}")
+        check(counts(grid.data)["tri_equivalent"] > counts(lod.data)["tri_equivalent"], "LOD is reduced")
+
     # A mesh without faces: an error report and a cancelled operator, Blender goes on.
     empty_mesh = bpy.data.meshes.new("Empty")
     empty_mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])

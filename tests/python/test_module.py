@@ -269,6 +269,48 @@ def test_symmetry_keeps_a_mirrored_mesh_mirrored():
         quadlod.simplify(vertices, faces, ratio=0.4, symmetry="w")
 
 
+def test_morph_targets_are_carried_exactly_where_vertices_survive():
+    """Blend shapes (issue 34): morph_targets={name: (V, 3)} in, the same names out, one
+    displacement per output vertex; an output vertex at an input vertex's position carries that
+    vertex's displacement exactly, and the lod chain carries them level by level."""
+    n = 16  # a flat n × n grid of quads over the unit square: vertices that stay, stay exactly
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    vertices = np.stack([i / n, j / n, 0 * i], axis=-1).reshape(-1, 3).astype(float)
+    vid = lambda a, b: a * (n + 1) + b  # noqa: E731
+    quads = np.array([[vid(a, b), vid(a + 1, b), vid(a + 1, b + 1), vid(a, b + 1)]
+                      for a in range(n) for b in range(n)])
+    lift = np.zeros_like(vertices)
+    lift[:, 2] = 0.1 * vertices[:, 0]  # linear in x: any interpolation gives 0.1 x back
+    twist = np.zeros_like(vertices)
+    twist[vid(5, 8)] = [0.0, 0.05, 0.2]
+    r = quadlod.simplify(vertices, quads, ratio=0.4, morph_targets={"lift": lift, "twist": twist})
+    check_layout(r)
+    assert list(r["morph_targets"]) == ["lift", "twist"]
+    assert r["report"]["morph_targets"] == {"count": 2, "names": ["lift", "twist"]}
+    out = r["vertices"]
+    for name in ("lift", "twist"):
+        assert r["morph_targets"][name].shape == out.shape
+    survivors = 0
+    for v, p in enumerate(out):
+        same = np.flatnonzero(np.all(vertices == p, axis=1))
+        if len(same):
+            survivors += 1
+            np.testing.assert_array_equal(r["morph_targets"]["lift"][v], lift[same[0]])
+            np.testing.assert_array_equal(r["morph_targets"]["twist"][v], twist[same[0]])
+    assert survivors >= 10
+    np.testing.assert_allclose(r["morph_targets"]["lift"][:, 2], 0.1 * out[:, 0], atol=1e-12)
+    chain = quadlod.lod_chain(vertices, quads, ratios=[0.5, 0.25], morph_targets={"lift": lift},
+                              measure_hausdorff=False, morph_weight=2.0)
+    for level in chain:
+        assert list(level["morph_targets"]) == ["lift"]
+        np.testing.assert_allclose(level["morph_targets"]["lift"][:, 2], 0.1 * level["vertices"][:, 0], atol=1e-12)
+        assert level["report"]["options"]["morph_error_weight"] == 2.0
+    with pytest.raises(ValueError, match=r"morph_targets\['lift'\]: 3 rows for 289 vertices"):
+        quadlod.simplify(vertices, quads, ratio=0.4, morph_targets={"lift": lift[:3]})
+    with pytest.raises(ValueError, match="morph_weight"):
+        quadlod.simplify(vertices, quads, ratio=0.4, morph_weight=-1.0)
+
+
 def test_the_input_arrays_are_not_modified():
     vertices, quads, uvs, materials = torus()
     copies = [a.copy() for a in (vertices, quads, uvs, materials)]

@@ -120,7 +120,42 @@ def _mesh_arrays(mesh):
         if order is not None:
             normals = normals[order]
     return dict(vertices=vertices.reshape(nv, 3), faces=(corners, sizes), uvs=uvs or None,
-                materials=materials, normals=normals)
+                materials=materials, normals=normals, morph_targets=_shape_keys(mesh, vertices.reshape(nv, 3)))
+
+
+def _shape_keys(mesh, vertices):
+    """Issue 34: {name: (V, 3) key co - basis co} of the mesh's shape keys (None without any)."""
+    keys = mesh.shape_keys
+    if keys is None or len(keys.key_blocks) < 2:
+        return None
+    reference = keys.reference_key
+    basis = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    reference.data.foreach_get("co", basis)
+    shapes = {}
+    for block in keys.key_blocks:
+        if block == reference:
+            continue
+        co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        block.data.foreach_get("co", co)
+        shapes[block.name] = (co - basis).reshape(-1, 3).astype(np.float64)
+    return shapes
+
+
+def _add_shape_keys(source_obj, lod_obj, level):
+    """Issue 34: the LOD's carried shapes as shape keys of the LOD object, with the source's values."""
+    shapes = level.get("morph_targets")
+    if not shapes:
+        return
+    source_keys = source_obj.data.shape_keys
+    vertices = np.asarray(level["vertices"], dtype=np.float64)
+    lod_obj.shape_key_add(name=source_keys.reference_key.name if source_keys else "Basis", from_mix=False)
+    for name, displacement in shapes.items():
+        block = lod_obj.shape_key_add(name=name, from_mix=False)
+        block.data.foreach_set("co", (vertices + np.asarray(displacement)).astype(np.float32).ravel())
+        if source_keys is not None and name in source_keys.key_blocks:
+            source = source_keys.key_blocks[name]
+            block.slider_min, block.slider_max = source.slider_min, source.slider_max
+            block.value = source.value
 
 
 def _vertex_weights(obj):
@@ -287,13 +322,14 @@ class QUADLOD_OT_make_lods(bpy.types.Operator):
             options.update(protect=protect)
         level = _core.simplify(src["vertices"], faces, faces_target=self._target(state["size"], k),
                                uvs=src.get("uvs"), normals=src.get("normals"),
-                               materials=src.get("materials"), **options)
+                               materials=src.get("materials"), morph_targets=src.get("morph_targets"), **options)
         state["previous"] = level
         me = _build_mesh(f"{obj.name}_LOD{k}", level, obj, state["all_smooth"])
         lod = bpy.data.objects.new(f"{obj.name}_LOD{k}", me)
         lod.matrix_world = obj.matrix_world.copy()
         state["collection"].objects.link(lod)
         _copy_vertex_groups(obj, lod, state["weights"], state["positions"])
+        _add_shape_keys(obj, lod, level)
         lod["quadlod_report"] = {key: level["report"][key] for key in
                                  ("input_tri_equivalent", "target", "achieved", "quads", "triangles", "ngons")}
         if "protect" in level["report"]:
