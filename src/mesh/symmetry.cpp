@@ -28,7 +28,7 @@ bool finite(const Vec3& p) { return std::isfinite(p.x()) && std::isfinite(p.y())
 // around it.
 class HashGrid {
  public:
-  HashGrid(const std::vector<Vec3>& points, double cell) : points_(points), inv_(1.0 / cell) {
+  HashGrid(const std::vector<Vec3>& points, double cell) : inv_(1.0 / cell) {
     cells_.reserve(points.size());
     for (Index i = 0; i < Index(points.size()); ++i)
       if (finite(points[i])) cells_[key(cell_of(points[i]))].push_back(i);
@@ -58,7 +58,6 @@ class HashGrid {
     const std::uint64_t m = (1u << 21) - 1;
     return (std::uint64_t(c[0]) & m) | ((std::uint64_t(c[1]) & m) << 21) | ((std::uint64_t(c[2]) & m) << 42);
   }
-  const std::vector<Vec3>& points_;
   double inv_;
   std::unordered_map<std::uint64_t, std::vector<Index>> cells_;
 };

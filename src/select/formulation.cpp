@@ -250,11 +250,7 @@ void ModelBuilder::build_faces() {
       }
       if (k == 3) {  // triangle over several groups: z = AND (continuous, exact for binary y)
         const Col z = model.add_continuous(0.0, 1.0);
-        double s = 0;
-        for (const Term& t : terms) {
-          model.add_le({{z, t.coef}, {t.col, -t.coef}}, 0.0);  // m z ≤ m y
-          s += t.coef;
-        }
+        for (const Term& t : terms) model.add_le({{z, t.coef}, {t.col, -t.coef}}, 0.0);  // m z ≤ m y
         std::vector<Term> row = terms;
         row.push_back({z, -1.0});
         model.add_le(row, 2.0);  // z ≥ S − 2
