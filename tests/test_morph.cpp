@@ -499,7 +499,7 @@ for path in sys.argv[sys.argv.index("--") + 1:]:
     for (std::size_t at = out.find(tag); at != std::string::npos; at = out.find(tag, at + 1)) {
       Vec3 d;
       ASSERT_EQ(std::sscanf(out.c_str() + at + tag.size(), "%lf %lf %lf", &d[0], &d[1], &d[2]), 3);
-      auto blender_of = [&](Index v) {
+      auto blender_of = [&, scale = scale](Index v) {  // a copy: clang 15 cannot capture a binding
         const Vec3& f = mesh.morph_targets[0].displacement[v];
         return Vec3(scale * f.x(), -scale * f.z(), scale * f.y());
       };
