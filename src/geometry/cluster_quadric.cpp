@@ -109,16 +109,32 @@ VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& c
   return out;
 }
 
-VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn,
-                                     const QuadricPlacementParams& params) {
+namespace {
+void face_normals_and_areas(const PolyMesh& mesh, std::vector<Vec3>& face_n, std::vector<double>& face_area) {
   const Index nf = mesh.num_faces();
-  std::vector<Vec3> face_n(nf);
-  std::vector<double> face_area(nf);
+  face_n.resize(nf);
+  face_area.resize(nf);
   for (Index f = 0; f < nf; ++f) {
     const Vec3 av = face_area_vector(mesh, f);
     face_area[f] = av.norm();
     face_n[f] = face_area[f] > 0.0 ? Vec3(av / face_area[f]) : Vec3::Zero();
   }
+}
+}  // namespace
+
+VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn, double mean_edge,
+                                     const QuadricPlacementParams& params) {
+  std::vector<Vec3> face_n;
+  std::vector<double> face_area;
+  face_normals_and_areas(mesh, face_n, face_area);
+  return build_vertex_quadrics(mesh, conn, face_n, face_area, mean_edge, params);
+}
+
+VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn,
+                                     const QuadricPlacementParams& params) {
+  std::vector<Vec3> face_n;
+  std::vector<double> face_area;
+  face_normals_and_areas(mesh, face_n, face_area);
   double sum = 0.0;
   Index counted = 0;
   for (Index e = 0; e < conn.num_edges; ++e) {

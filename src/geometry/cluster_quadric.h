@@ -120,6 +120,11 @@ struct VertexQuadrics {
 VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn, const std::vector<Vec3>& face_normal,
                                      const std::vector<double>& face_area, double mean_edge,
                                      const QuadricPlacementParams& params);
+/// The same, computing normals and areas itself, with a given h (a deformed copy of a mesh
+/// — a pose, a blend shape — keeps the undeformed mesh's h, so that stretching some edges does
+/// not rescale the edge planes of every vertex).
+VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn, double mean_edge,
+                                     const QuadricPlacementParams& params);
 /// The same, computing normals, areas and h itself.
 VertexQuadrics build_vertex_quadrics(const PolyMesh& mesh, const Connectivity& conn,
                                      const QuadricPlacementParams& params);

@@ -18,15 +18,7 @@ void add_morph_quadrics(VertexQuadrics& quadrics, const PolyMesh& mesh, const Co
     const PolyMesh shaped = apply_morph_target(mesh, k);
     // The base's h (mean edge length), as for poses: a shape that stretches some edges must not
     // rescale the edge planes of every vertex.
-    const Index nf = shaped.num_faces();
-    std::vector<Vec3> face_n(nf);
-    std::vector<double> face_area(nf);
-    for (Index f = 0; f < nf; ++f) {
-      const Vec3 av = face_area_vector(shaped, f);
-      face_area[f] = av.norm();
-      face_n[f] = face_area[f] > 0.0 ? Vec3(av / face_area[f]) : Vec3::Zero();
-    }
-    const VertexQuadrics at = build_vertex_quadrics(shaped, conn, face_n, face_area, quadrics.mean_edge, placement);
+    const VertexQuadrics at = build_vertex_quadrics(shaped, conn, quadrics.mean_edge, placement);
     const std::vector<Vec3>& d = mesh.morph_targets[k].displacement;
     for (Index v = 0; v < n; ++v) {
       Eigen::Matrix4d m = Eigen::Matrix4d::Identity();

@@ -29,15 +29,7 @@ VertexQuadrics build_pose_vertex_quadrics(const PolyMesh& mesh, const Connectivi
     const PolyMesh posed = pose_mesh(mesh, pose);
     // The bind pose's h (mean edge length): a pose that stretches or shrinks some edges must not
     // rescale the edge planes of every vertex (rigid parts keep their quadric exactly).
-    const Index nf = posed.num_faces();
-    std::vector<Vec3> face_n(nf);
-    std::vector<double> face_area(nf);
-    for (Index f = 0; f < nf; ++f) {
-      const Vec3 av = face_area_vector(posed, f);
-      face_area[f] = av.norm();
-      face_n[f] = face_area[f] > 0.0 ? Vec3(av / face_area[f]) : Vec3::Zero();
-    }
-    const VertexQuadrics at = build_vertex_quadrics(posed, conn, face_n, face_area, bind.mean_edge, placement);
+    const VertexQuadrics at = build_vertex_quadrics(posed, conn, bind.mean_edge, placement);
     for (Index v = 0; v < n; ++v) {
       Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
       double w = 0.0;
