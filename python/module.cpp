@@ -90,6 +90,8 @@ const std::map<std::string, OptionSetter>& option_table() {
       {"surface_fit", set_field(&SimplifyOptions::surface_fit_iterations)},
       {"recover_quads", set_choice(&SimplifyOptions::recover_quads, "recover_quads", quad_recovery_names())},
       {"seams", set_choice(&SimplifyOptions::seams, "seams", seam_policy_names())},
+      {"bend_lines_below", set_field(&SimplifyOptions::bend_lines_below_ratio)},  // issue 32
+      {"max_line_tolerance", set_field(&SimplifyOptions::max_line_tolerance)},
       {"surface_fit_vertex_weight", set_field(&SimplifyOptions::surface_fit_vertex_weight)},
       {"morph_weight", set_field(&SimplifyOptions::morph_error_weight)},  // issue 34
       {"decide_on_doubles", [](SimplifyOptions& o, const py::handle& v) { o.float32_decisions = !v.cast<bool>(); }},

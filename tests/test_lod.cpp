@@ -75,6 +75,29 @@ TEST(LodChain, LevelsShrinkAndAreMeasuredAgainstTheInput) {
   EXPECT_EQ(from_previous.mesh.positions, chain.levels[2].mesh.positions);
 }
 
+// Lines bend below a fraction of the CHAIN's input (issue 32), though each level is reduced from
+// the previous one: the cylinder's 2 % level is 0.4 of its 5 % level, yet its rims bend (see
+// Simplify.FarBelowTheBendRatioCurvedLinesBendAndTheRunGetsCloser), and levels at or above 10 %
+// keep every line within the strict tolerance.
+TEST(LodChain, LinesBendBelowAFractionOfTheChainsInput) {
+  const PolyMesh cylinder = make_cylinder(16, 24);
+  LodChainParams params;
+  params.ratios = {0.5, 0.2, 0.1, 0.05, 0.02};
+  params.simplify.progress = false;
+  params.hausdorff_samples = 2000;
+  const LodChainResult chain = lod_chain(cylinder, params);
+  ASSERT_TRUE(chain.ok()) << chain.error;
+  ASSERT_EQ(chain.levels.size(), 5u);
+  for (std::size_t l = 0; l < 3; ++l)
+    EXPECT_EQ(chain.levels[l].report["seams"]["line_tolerance"].get<double>(), 0.2) << "level " << l;
+  EXPECT_GT(chain.levels[4].report["seams"]["line_tolerance"].get<double>(), 0.2);
+  params.simplify.bend_lines_below_ratio = 0.0;
+  const LodChainResult kept = lod_chain(cylinder, params);
+  ASSERT_TRUE(kept.ok()) << kept.error;
+  EXPECT_EQ(kept.levels[4].report["seams"]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_LT(chain.levels[4].achieved, kept.levels[4].achieved);
+}
+
 TEST(LodChain, BadRatiosAreErrors) {
   LodChainParams params;
   params.ratios = {0.5, 0.6};

@@ -407,6 +407,57 @@ TEST(Simplify, SeamsShortenThroughTheirJunctions) {
   EXPECT_LT(on_seam, 9u);
 }
 
+// Far LODs (issue 32): below SimplifyOptions::bend_lines_below_ratio, once crossing islands no
+// longer helps, a stalled run lets lines bend. The cylinder's rims are 16-gons (radius 0.5): an
+// output edge over k of their edges leaves them by (r − r cos(kπ/16)) / (2r sin(kπ/16)) of its
+// length at its midpoint, 0.134 for k = 3 and 0.207 for k = 4, so within the strict tolerance
+// (0.2) each rim keeps at least ⌈16/3⌉ = 6 edges and a 2 % budget (15 tri-equivalents) is out of
+// reach. Bent, the rims shorten further and the run gets closer.
+int boundary_edges(const PolyMesh& mesh) {
+  const Connectivity conn = build_connectivity(mesh);
+  int n = 0;
+  for (std::size_t e = 0; e + 1 < conn.edge_corner_offsets.size(); ++e)
+    n += conn.edge_corner_offsets[e + 1] - conn.edge_corner_offsets[e] == 1;
+  return n;
+}
+
+TEST(Simplify, FarBelowTheBendRatioCurvedLinesBendAndTheRunGetsCloser) {
+  const PolyMesh cylinder = make_cylinder(16, 24);
+  SimplifyOptions kept;
+  kept.ratio = 0.02;
+  kept.bend_lines_below_ratio = 0.0;
+  const SimplifyResult a = simplify(cylinder, kept);
+  ASSERT_TRUE(a.ok()) << a.error;
+  EXPECT_EQ(a.report["seams"]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_GE(boundary_edges(a.mesh), 12);
+  SimplifyOptions bend;
+  bend.ratio = 0.02;
+  const SimplifyResult b = simplify(cylinder, bend);
+  ASSERT_TRUE(b.ok()) << b.error;
+  EXPECT_GT(b.report["seams"]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_LE(b.report["seams"]["line_tolerance"].get<double>(), bend.max_line_tolerance);
+  EXPECT_LT(boundary_edges(b.mesh), 12);
+  EXPECT_LT(b.achieved, a.achieved);
+  expect_valid(cylinder, b.mesh, "bent");
+  // Passes before the bend ran at the strict tolerance; the report shows where it rose.
+  const auto& passes = b.report["passes"];
+  EXPECT_EQ(passes[0]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_GT(passes.back()["line_tolerance"].get<double>(), 0.2);
+  // --seams strict never bends; neither does a target at or above the bend ratio.
+  SimplifyOptions strict = bend;
+  strict.seams = SimplifyOptions::SeamPolicy::Strict;
+  const SimplifyResult c = simplify(cylinder, strict);
+  ASSERT_TRUE(c.ok()) << c.error;
+  EXPECT_EQ(c.report["seams"]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_GE(boundary_edges(c.mesh), 12);
+  SimplifyOptions tenth;
+  tenth.ratio = 0.1;
+  const SimplifyResult d = simplify(cylinder, tenth);
+  ASSERT_TRUE(d.ok()) << d.error;
+  EXPECT_EQ(d.report["seams"]["line_tolerance"].get<double>(), 0.2);
+  EXPECT_GE(boundary_edges(d.mesh), 12);
+}
+
 TEST(SimplifyCli, WritesOutputAndReportAndNeverOverwritesTheInput) {
   using namespace quadlod::testing;
   const auto dir = scratch_dir("simplify-cli");

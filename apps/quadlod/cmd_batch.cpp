@@ -21,6 +21,7 @@ struct BatchCliOptions {
   std::string objective;
   std::string recover_quads;
   std::string seams;
+  double bend_lines_below = -1.0;  // < 0: the manifest's or the default
   std::string protect_from;  // issue 34
   int threads = -1;
   std::string symmetry;  // issue 34
@@ -51,6 +52,9 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"auto", "on", "off"}));
   sub->add_option("--seams", opt->seams, "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->check(CLI::IsMember({"auto", "strict"}));
+  sub->add_option("--bend-lines-below", opt->bend_lines_below,
+                  "Below this fraction of the input, lines may bend when a pass stalls (as in simplify)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--threads", opt->threads, "Threads per asset (0 = all cores)")->check(CLI::Range(0, 256));
   // --- symmetry (issue 34; docs/symmetry.md) ---
   sub->add_option("--symmetry", opt->symmetry, "Mirror-symmetric reduction: auto, x, y, z or off (as in simplify)")
@@ -81,6 +85,7 @@ Command add_batch(CLI::App& app, const GlobalOptions& global) {
             if (!opt->objective.empty()) defaults["objective"] = opt->objective;
             if (!opt->recover_quads.empty()) defaults["recover_quads"] = opt->recover_quads;
             if (!opt->seams.empty()) defaults["seams"] = opt->seams;
+            if (opt->bend_lines_below >= 0.0) defaults["bend_lines_below"] = opt->bend_lines_below;
             if (opt->threads >= 0) defaults["threads"] = opt->threads;
             if (opt->no_features) defaults["features"] = false;
             if (!opt->protect_from.empty()) defaults["protect_from"] = opt->protect_from;  // issue 34

@@ -56,6 +56,9 @@ Command add_lod(CLI::App& app, const GlobalOptions& global) {
   add_choice_option(sub, "--seams", p.seams, seam_policy_names(),
                     "Strict lines below the budget they leave room for: auto or strict (as in simplify)")
       ->group("Reduction");
+  sub->add_option("--bend-lines-below", p.bend_lines_below_ratio,
+                  "Levels below this fraction of the input may bend lines (as in simplify; 0 = never)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group("Reduction");
   sub->add_option("--seed", p.seed, "Solver seed")->capture_default_str()->group("Reduction");
   // --- symmetry (issue 34; docs/symmetry.md) ---
   add_choice_option(sub, "--symmetry", p.symmetry, symmetry_names(),

@@ -145,6 +145,13 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                     "lines around the smallest islands may merge through them when a pass stalls, counted in the report), "
                     "strict (never; the note says how far from the target that stopped)")
       ->group("Features");
+  sub->add_option("--bend-lines-below", p.bend_lines_below_ratio,
+                  "With --seams auto, below this fraction of the input the lines may also bend when a pass stalls: fewer, "
+                  "longer edges cut their curves, counted as seams torn (0 = never)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group("Features");
+  sub->add_option("--max-line-tolerance", p.max_line_tolerance,
+                  "How far a bent line may leave its input line, in output edge lengths (0.2 = not at all)")
+      ->check(CLI::Range(0.2, 10.0))->capture_default_str()->group("Features");
   sub->add_flag("--place-on-hard-edges", p.place_on_hard_edges,
                 "Keep merged vertices on hard edges (else they follow their quadric, which weighs sharp edges heavily)")
       ->group("Features");
@@ -355,6 +362,10 @@ Command add_simplify(CLI::App& app, const GlobalOptions& global) {
                           static_cast<unsigned long long>(seams["line_crossings"].get<std::uint64_t>()), faces,
                           seams["vanishing_part_area"].get<double>() > 0.0 ? "; parts that small may vanish" : "");
             }
+            if (rep.contains("seams") && rep["seams"].value("line_tolerance", 0.2) > 0.2 + 1e-9)
+              std::printf("seams: lines bent up to %.1f output edge lengths off their input lines to reach the budget; "
+                          "eval counts those edges as seams torn (--bend-lines-below 0 keeps them)\n",
+                          rep["seams"]["line_tolerance"].get<double>());
             print_symmetry_line(rep);
             if (!r.note.empty()) std::printf("note: %s\n", r.note.c_str());
             return kExitOk;

@@ -170,6 +170,18 @@ struct SimplifyOptions {
   ///   * Strict: never; the note then says how far from the target the run stopped, and why.
   enum class SeamPolicy : std::uint8_t { Auto, Strict };
   SeamPolicy seams = SeamPolicy::Auto;
+  /// SeamPolicy::Auto bends lines (below) only when the target is below this fraction of the
+  /// input: issue 32 asks that no seam tear down to 0.1, and lets lines give way below it, where
+  /// they alone can outnumber the budget. A LOD chain rescales it so that it refers to the chain's
+  /// input, not the previous level. 0 never bends.
+  double bend_lines_below_ratio = 0.1;
+  /// SeamPolicy::Auto at far LODs: once every island may cross and a pass still stalls, the
+  /// strict lines' tolerance (ClusterCollapseParams::feature_tolerance, 0.2 of an output edge's
+  /// length, eval's seams_torn rule) doubles per further stall up to this bound, so a curved line
+  /// may be cut by fewer, longer edges; eval counts those edges as torn. The report gives the
+  /// tolerance reached (`seams.line_tolerance`, per pass `passes[i].line_tolerance`). A value at
+  /// or below 0.2 never bends. Measured in docs/attributes.md, "Far LODs".
+  double max_line_tolerance = 1.6;
   /// Dihedral angle (degrees) from which a manifold edge is a hard edge (default ϵ_θ).
   double hard_angle_deg = 60.0;
   /// Place clusters that touch hard edges (and no other feature) on the hard line, as issue 7

@@ -36,7 +36,7 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
                           std::vector<double>& levels, std::string& format) {
   static const std::set<std::string> kKnown = {"ratio", "faces",     "levels", "count",  "format", "per_mesh",
                                                "objective", "time_limit", "threads", "seed", "features",
-                                               "recover_quads", "seams",
+                                               "recover_quads", "seams", "bend_lines_below",
                                                "protect", "protect_from",
                                                "symmetry", "morph_weight"};  // issue 34
   if (!options.is_object()) return "options must be a JSON object";
@@ -64,6 +64,11 @@ std::string apply_options(const nlohmann::json& options, SimplifyOptions& simpli
       const auto policy = parse_seam_policy(options["seams"].get<std::string>());
       if (!policy) return "seams must be auto or strict";
       simplify.seams = *policy;
+    }
+    if (options.contains("bend_lines_below")) {  // issue 32: far LODs
+      simplify.bend_lines_below_ratio = options["bend_lines_below"].get<double>();
+      if (!(simplify.bend_lines_below_ratio >= 0.0 && simplify.bend_lines_below_ratio <= 1.0))
+        return "bend_lines_below must be in [0, 1]";
     }
     if (options.contains("protect_from")) {  // issue 34; "protect" (a file) is read with the input
       const auto channel = parse_protect_channel(options["protect_from"].get<std::string>());

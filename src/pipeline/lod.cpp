@@ -75,6 +75,9 @@ LodChainResult lod_chain(const PolyMesh& input, const LodChainParams& params) {
     options.ratio = 1.0;
     options.target_tri_equivalent =
         std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(ratio * double(result.input_tri_equivalent))));
+    // Lines bend below a fraction of the chain's input, not of the previous level (issue 32).
+    options.bend_lines_below_ratio = params.simplify.bend_lines_below_ratio * double(result.input_tri_equivalent) /
+                                     double(std::max<std::uint64_t>(1, tri_equivalent_count(*previous)));
     const auto reduce_start = std::chrono::steady_clock::now();
     // A level already at or below its target (a tiny mesh) is the previous level unchanged.
     SimplifyResult reduced;

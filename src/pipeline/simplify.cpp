@@ -669,6 +669,11 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     result.error = "the target ratio must be in (0, 1]";
     return result;
   }
+  if (!(options.bend_lines_below_ratio >= 0.0) || !std::isfinite(options.bend_lines_below_ratio) ||
+      !(options.max_line_tolerance > 0.0) || !std::isfinite(options.max_line_tolerance)) {
+    result.error = "bend_lines_below must be >= 0 and max_line_tolerance > 0";
+    return result;
+  }
   if (!(options.effort > 0.0) || !std::isfinite(options.effort)) {
     result.error = "the effort must be a positive number";
     return result;
@@ -896,6 +901,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                       {"time_limit_seconds", pass_time},
                       {"crossing_island_area", crossing_area},
                       {"vanishing_part_area", vanishing_part_area},
+                      {"line_tolerance", cp.feature_tolerance},
                       {"report", outcome.report}});
     // A pass that removed less than half of what it was asked to, its lines pinning the rest, and
     // ended more than 3 % above its target, stalled: with SeamPolicy::Auto the lines around the next larger islands may then merge
@@ -905,14 +911,24 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                          2 * (outcome.achieved - pass_target) > pass_in - std::min(pass_in, pass_target);
     const bool can_cross = options.seams == SimplifyOptions::SeamPolicy::Auto && options.features &&
                            crossing_area <= input_area;
+    // Once every island may cross and a pass still stalls, the lines themselves outnumber the
+    // budget (far LODs: a curved seam of 12 edges cannot stay within 0.2 of an edge's length when
+    // the budget leaves it 3). Their tolerance then doubles per further stall, up to
+    // max_line_tolerance: output lines may cut their input lines' curves, and eval counts each
+    // such edge as torn (seams_torn). SeamPolicy::Strict never bends.
+    const bool can_bend = options.seams == SimplifyOptions::SeamPolicy::Auto && options.features && !can_cross &&
+                          n < options.bend_lines_below_ratio * n0 && cp.feature_tolerance < options.max_line_tolerance;
     if (stalled && can_cross) {
       crossing_area = std::max(4.0 * crossing_area, cp.min_kept_island_area);
       vanishing_part_area = crossing_area;
       if (options.max_passes < 0) pass_limit = max_passes + kCrossingPasses;  // not when the user set it
+    } else if (stalled && can_bend) {
+      cp.feature_tolerance = std::min(2.0 * cp.feature_tolerance, options.max_line_tolerance);
+      if (options.max_passes < 0) pass_limit = std::max(pass_limit, pass + kCrossingPasses / 2);
     }
     const bool improved = pass <= planned || outcome.achieved < last.achieved;
     if (!improved) {  // an extra pass that does not get closer is dropped
-      if (stalled && can_cross) continue;
+      if (stalled && (can_cross || can_bend)) continue;
       break;
     }
     // A pass that removed nothing (its selection found nothing, or the collapse refused all of it:
@@ -922,7 +938,7 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
     // (A pass whose target was within kStallMiss of its input, which removed nothing, is not stuck:
     // the next planned pass asks for more.)
     const bool near = double(outcome.achieved) <= (1.0 + kStallMiss) * double(pass_target);
-    const bool stuck = outcome.achieved == pass_in && !near && !(stalled && can_cross);
+    const bool stuck = outcome.achieved == pass_in && !near && !(stalled && (can_cross || can_bend));
     if (outcome.report.contains("collapse")) line_crossings += outcome.report["collapse"].value("line_crossings", Index{0});
     last = std::move(outcome);
     for (Index& f : last.face_source) f = face_origin[f];
@@ -950,7 +966,8 @@ static SimplifyResult simplify_once(const PolyMesh& input, const SimplifyOptions
                      {"crossing_island_area", crossing_area},
                      {"one_output_face_area", cp.min_kept_island_area},
                      {"vanishing_part_area", vanishing_part_area},
-                     {"line_crossings", line_crossings}};
+                     {"line_crossings", line_crossings},
+                     {"line_tolerance", cp.feature_tolerance}};
   report["time_bound_reached"] = time_bound_reached;
   report["stage_seconds"] = {{"analysis", seconds_analysis},
                              {"select", seconds_select},
